@@ -1,0 +1,129 @@
+// Hysteresis-creep operator (paper eq. 26-29, in Kuhnen's modified-PI form) and its inverse.
+//
+//   Gamma[x] = S[ H[x] + K[x] ]
+//   H[x] = sum_{i=0..n} w_i p_i            PI operator, p_0 = x, thresholds 0 = r_0 < ... < r_n
+//   K[x] = sum_{i,j} c_ij z_ij             creep elements: lag lambda_j on the play of threshold
+//                                          r_i (ThresholdCreep), c_ij >= 0
+//   S                                      dead-zone superposition (asymmetry, saturation)
+// The paper's K = L[H[x]] (eq. 28) is the rank-one case c_ij = w_i c_j (with_nonlinear_creep()).
+// H and K share one play bank: the union of their thresholds.
+//
+// Inverse, one sample at a time (inverse_step). With a_j = 1 - exp(-lambda_j Ts) the lags give
+//   K[x][k] = sum_i b_i p_i[k] + sum_{i,j} c_ij (1 - a_j) z_ij[k-1],   b_i = sum_j c_ij a_j,
+// so at sample k, H + K is a PI operator with weights w_i + b_i (fixed for a fixed Ts) plus a
+// known carry from the previous lag states. Hence
+//   v = S^-1[y],  x = H~^-1[v - carry],  H~ = PI(r, w + b),
+// all closed form; H~^-1 is evaluated from the current forward play states (no separate
+// inverse state that could drift). The weights keep H~ invertible because c_ij >= 0.
+//
+// step() and inverse_step() are real-time safe: O(n_plays + n_creep + n_deadzones), no
+// allocation, no exceptions.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "selfsense/operators/dead_zone_superposition.hpp"
+#include "selfsense/operators/linear_creep.hpp"
+#include "selfsense/operators/prandtl_ishlinskii.hpp"
+#include "selfsense/operators/threshold_creep.hpp"
+
+namespace selfsense::operators {
+
+class HysteresisCreep final {
+ public:
+  struct Params {
+    PrandtlIshlinskii::Params hysteresis{};
+    DeadZoneSuperposition::Params superposition{};  // default: identity
+    ThresholdCreep::Params creep{};                 // default: no creep
+
+    [[nodiscard]] bool is_valid(std::string* why) const;
+  };
+
+  // Paper eq. (28): K = L[H[x]], i.e. creep weights c_ij = w_i c_j on the PI thresholds.
+  // Throws ParameterError if a PI weight is negative (creep weights must stay >= 0).
+  [[nodiscard]] static Params with_nonlinear_creep(const PrandtlIshlinskii::Params& hysteresis,
+                                                   const DeadZoneSuperposition::Params& shape,
+                                                   const LinearCreep::Params& creep);
+
+  // Throws ParameterError naming the offending parameter. State: everything at 0.
+  HysteresisCreep(Params params, double sample_time);
+
+  [[nodiscard]] const Params& params() const noexcept { return params_; }
+  [[nodiscard]] double sample_time() const noexcept { return sample_time_; }
+
+  // Forward: input x in, output Gamma[x] out.
+  double step(double x) noexcept;
+  void apply(std::span<const double> x, std::span<double> y) noexcept;
+  // The input x that would make this sample's output equal y. Does not change the state
+  // (the non-const is for a scratch buffer).
+  [[nodiscard]] double input_for(double y) noexcept;
+  // Inverse: input_for(y), then advance with that x, so forward and inverse share one state.
+  double inverse_step(double y) noexcept;
+  void apply_inverse(std::span<const double> y, std::span<double> x) noexcept;
+  [[nodiscard]] double output() const noexcept;
+
+  // State: the shared play bank (one value per union threshold), then the creep lags
+  // (row-major, creep thresholds x eigenvalues).
+  [[nodiscard]] std::span<const double> state() const noexcept { return state_; }
+  void set_state(std::span<const double> state) noexcept;
+  // Equilibrium at a constant input x (all plays and lags at x).
+  void reset(double x = 0.0) noexcept;
+  // Union of hysteresis and creep thresholds, r_0 = 0 first: what the play states refer to.
+  [[nodiscard]] std::span<const double> play_thresholds() const noexcept { return thresholds_; }
+
+ private:
+  [[nodiscard]] std::size_t play_count() const noexcept { return thresholds_.size(); }
+  [[nodiscard]] std::span<double> plays() noexcept {
+    return std::span(state_).first(play_count());
+  }
+  [[nodiscard]] std::span<double> lags() noexcept {
+    return std::span(state_).subspan(play_count());
+  }
+  [[nodiscard]] double inner_step(double x) noexcept;  // H[x] + K[x], advancing the state
+
+  Params params_{};
+  double sample_time_{0.0};
+  DeadZoneSuperposition shape_{};
+  DeadZoneSuperposition shape_inverse_{};
+  std::vector<double> thresholds_{};          // union, r_0 = 0 first
+  std::vector<double> hysteresis_weights_{};  // w on the union (0 where only creep has a play)
+  std::vector<std::size_t> creep_rows_{};     // play index of each creep threshold
+  std::vector<double> creep_weights_{};       // c_ij, row-major
+  std::vector<double> creep_gains_{};         // a_j per element, row-major
+  std::vector<double> carry_weights_{};       // c_ij (1 - a_j), row-major
+  std::vector<double> inverse_thresholds_{};  // r' of H~^-1
+  std::vector<double> inverse_weights_{};     // w' of H~^-1
+  std::vector<double> effective_weights_{};   // w + b
+  std::vector<double> scratch_{};             // inverse play states, sized once
+  std::vector<double> state_{};               // plays, then lags
+};
+
+// Feedforward inverse compensator (the paper's reference [11]): desired output in, actuator
+// input out, so that the modelled actuator follows the desired trajectory. The input is limited
+// to [input_min, input_max] (the amplifier's range); when it saturates (or the desired output
+// is NaN), the internal model advances with the limited input so its state stays that of the
+// real actuator, and the saturation is counted.
+class HysteresisCreepCompensator final {
+ public:
+  // Throws ParameterError unless input_min < input_max.
+  HysteresisCreepCompensator(HysteresisCreep model, double input_min, double input_max);
+
+  // Real-time safe.
+  double step(double desired_output) noexcept;
+  void apply(std::span<const double> desired, std::span<double> input) noexcept;
+
+  [[nodiscard]] const HysteresisCreep& model() const noexcept { return model_; }
+  [[nodiscard]] HysteresisCreep& model() noexcept { return model_; }
+  [[nodiscard]] std::size_t saturation_count() const noexcept { return saturations_; }
+
+ private:
+  HysteresisCreep model_;
+  double input_min_{0.0};
+  double input_max_{0.0};
+  std::size_t saturations_{0};
+};
+
+}  // namespace selfsense::operators

@@ -1,0 +1,13 @@
+// Sub-commands of the `selfsense` tool. Each file registers one sub-command on the app and
+// runs it; main() only dispatches.
+#pragma once
+
+namespace CLI {
+class App;
+}  // namespace CLI
+
+namespace selfsense::cli {
+
+void add_demo_command(CLI::App& app);
+
+}  // namespace selfsense::cli

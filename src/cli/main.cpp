@@ -1,0 +1,21 @@
+// selfsense: the command-line tool. Sub-commands live in their own files (commands.hpp).
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"selfsense: self-sensing piezo actuator tools"};
+  app.require_subcommand(1);
+  selfsense::cli::add_demo_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "selfsense: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}
