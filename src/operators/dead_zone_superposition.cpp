@@ -76,7 +76,8 @@ double DeadZoneSuperposition::evaluate(double y) const noexcept {
 
 void DeadZoneSuperposition::apply(std::span<const double> y, std::span<double> out) const noexcept {
   assert(y.size() == out.size());
-  for (std::size_t k = 0; k < y.size(); ++k) out[k] = evaluate(y[k]);
+  for (std::size_t k = 0; k < y.size(); ++k)
+    out[k] = evaluate(y[k]);
 }
 
 double DeadZoneSuperposition::slope(double y) const noexcept {

@@ -45,7 +45,8 @@ HysteresisCreep::Params HysteresisCreep::with_nonlinear_creep(
     require_valid(w[i] >= 0.0, "HysteresisCreep.with_nonlinear_creep: hysteresis weight " +
                                    std::to_string(i) +
                                    " is negative; L[H[x]] then needs negative creep weights");
-    for (const double cj : creep.weights) elements.weights.push_back(w[i] * cj);
+    for (const double cj : creep.weights)
+      elements.weights.push_back(w[i] * cj);
   }
   return Params{hysteresis, shape, std::move(elements)};
 }
@@ -53,9 +54,9 @@ HysteresisCreep::Params HysteresisCreep::with_nonlinear_creep(
 HysteresisCreep::HysteresisCreep(Params params, double sample_time)
     : params_(std::move(params)), sample_time_(sample_time) {
   std::string why;
-  require_valid(params_.is_valid(&why) &&
-                    check::positive("HysteresisCreep.sample_time", sample_time, &why),
-                why);
+  require_valid(
+      params_.is_valid(&why) && check::positive("HysteresisCreep.sample_time", sample_time, &why),
+      why);
   shape_ = DeadZoneSuperposition(params_.superposition);
   shape_inverse_ = shape_.inverse();
 
@@ -63,8 +64,8 @@ HysteresisCreep::HysteresisCreep(Params params, double sample_time)
   const auto& h = params_.hysteresis;
   const auto& c = params_.creep;
   thresholds_.push_back(0.0);
-  std::set_union(h.thresholds.begin(), h.thresholds.end(), c.thresholds.begin(),
-                 c.thresholds.end(), std::back_inserter(thresholds_));
+  std::set_union(h.thresholds.begin(), h.thresholds.end(), c.thresholds.begin(), c.thresholds.end(),
+                 std::back_inserter(thresholds_));
   thresholds_.erase(std::unique(thresholds_.begin(), thresholds_.end()), thresholds_.end());
   const std::size_t n = thresholds_.size();
   hysteresis_weights_.assign(n, 0.0);
@@ -105,17 +106,19 @@ double HysteresisCreep::inner_step(double x) noexcept {
   for (std::size_t i = 0; i < creep_rows_.size(); ++i) {
     const std::size_t e = i * cols;
     sum += kernels::lag_bank_step(p[creep_rows_[i]], std::span(creep_gains_).subspan(e, cols),
-                                  std::span(creep_weights_).subspan(e, cols),
-                                  z.subspan(e, cols));
+                                  std::span(creep_weights_).subspan(e, cols), z.subspan(e, cols));
   }
   return sum;
 }
 
-double HysteresisCreep::step(double x) noexcept { return shape_.evaluate(inner_step(x)); }
+double HysteresisCreep::step(double x) noexcept {
+  return shape_.evaluate(inner_step(x));
+}
 
 void HysteresisCreep::apply(std::span<const double> x, std::span<double> y) noexcept {
   assert(x.size() == y.size());
-  for (std::size_t k = 0; k < x.size(); ++k) y[k] = step(x[k]);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    y[k] = step(x[k]);
 }
 
 double HysteresisCreep::input_for(double y) noexcept {
@@ -134,7 +137,8 @@ double HysteresisCreep::inverse_step(double y) noexcept {
 
 void HysteresisCreep::apply_inverse(std::span<const double> y, std::span<double> x) noexcept {
   assert(x.size() == y.size());
-  for (std::size_t k = 0; k < y.size(); ++k) x[k] = inverse_step(y[k]);
+  for (std::size_t k = 0; k < y.size(); ++k)
+    x[k] = inverse_step(y[k]);
 }
 
 double HysteresisCreep::output() const noexcept {
@@ -148,7 +152,9 @@ void HysteresisCreep::set_state(std::span<const double> state) noexcept {
   std::copy(state.begin(), state.end(), state_.begin());
 }
 
-void HysteresisCreep::reset(double x) noexcept { std::fill(state_.begin(), state_.end(), x); }
+void HysteresisCreep::reset(double x) noexcept {
+  std::fill(state_.begin(), state_.end(), x);
+}
 
 HysteresisCreepCompensator::HysteresisCreepCompensator(HysteresisCreep model, double input_min,
                                                        double input_max)
@@ -157,8 +163,7 @@ HysteresisCreepCompensator::HysteresisCreepCompensator(HysteresisCreep model, do
   require_valid(check::finite("HysteresisCreepCompensator.input_min", input_min, &why) &&
                     check::finite("HysteresisCreepCompensator.input_max", input_max, &why),
                 why);
-  require_valid(input_min < input_max,
-                "HysteresisCreepCompensator.input_max: must be > input_min");
+  require_valid(input_min < input_max, "HysteresisCreepCompensator.input_max: must be > input_min");
 }
 
 double HysteresisCreepCompensator::step(double desired_output) noexcept {
@@ -174,7 +179,8 @@ double HysteresisCreepCompensator::step(double desired_output) noexcept {
 void HysteresisCreepCompensator::apply(std::span<const double> desired,
                                        std::span<double> input) noexcept {
   assert(desired.size() == input.size());
-  for (std::size_t k = 0; k < desired.size(); ++k) input[k] = step(desired[k]);
+  for (std::size_t k = 0; k < desired.size(); ++k)
+    input[k] = step(desired[k]);
 }
 
 }  // namespace selfsense::operators

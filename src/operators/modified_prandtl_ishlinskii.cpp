@@ -7,7 +7,8 @@ namespace selfsense::operators {
 
 void ModifiedPrandtlIshlinskii::apply(std::span<const double> x, std::span<double> y) noexcept {
   assert(x.size() == y.size());
-  for (std::size_t k = 0; k < x.size(); ++k) y[k] = step(x[k]);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    y[k] = step(x[k]);
 }
 
 ModifiedPrandtlIshlinskiiInverse ModifiedPrandtlIshlinskii::inverse() const {
@@ -17,7 +18,8 @@ ModifiedPrandtlIshlinskiiInverse ModifiedPrandtlIshlinskii::inverse() const {
 void ModifiedPrandtlIshlinskiiInverse::apply(std::span<const double> y,
                                              std::span<double> x) noexcept {
   assert(x.size() == y.size());
-  for (std::size_t k = 0; k < y.size(); ++k) x[k] = step(y[k]);
+  for (std::size_t k = 0; k < y.size(); ++k)
+    x[k] = step(y[k]);
 }
 
 }  // namespace selfsense::operators

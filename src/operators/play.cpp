@@ -15,7 +15,8 @@ PlayOperator::PlayOperator(double threshold, double initial_output)
 
 void PlayOperator::apply(std::span<const double> x, std::span<double> y) noexcept {
   assert(x.size() == y.size());
-  for (std::size_t k = 0; k < x.size(); ++k) y[k] = step(x[k]);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    y[k] = step(x[k]);
 }
 
 StopOperator::StopOperator(double threshold, double last_input, double last_output)
@@ -23,7 +24,8 @@ StopOperator::StopOperator(double threshold, double last_input, double last_outp
 
 void StopOperator::apply(std::span<const double> x, std::span<double> y) noexcept {
   assert(x.size() == y.size());
-  for (std::size_t k = 0; k < x.size(); ++k) y[k] = step(x[k]);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    y[k] = step(x[k]);
 }
 
 }  // namespace selfsense::operators

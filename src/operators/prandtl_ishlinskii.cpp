@@ -23,8 +23,9 @@ bool PrandtlIshlinskii::Params::is_valid(std::string* why) const {
     if (!(partial_sum > 0.0)) {
       if (why != nullptr) {
         *why = "PrandtlIshlinskii.weights[" + std::to_string(i) +
-               "]: partial sum linear_weight + weights[0.." + std::to_string(i) + "] = " +
-               format_number(partial_sum) + " must be > 0 (else the operator is not invertible)";
+               "]: partial sum linear_weight + weights[0.." + std::to_string(i) +
+               "] = " + format_number(partial_sum) +
+               " must be > 0 (else the operator is not invertible)";
       }
       return false;
     }
@@ -45,7 +46,8 @@ PrandtlIshlinskii::PrandtlIshlinskii(const Params& params) {
 }
 
 PrandtlIshlinskii::Params PrandtlIshlinskii::params() const {
-  return Params{weights_.front(), {thresholds_.begin() + 1, thresholds_.end()},
+  return Params{weights_.front(),
+                {thresholds_.begin() + 1, thresholds_.end()},
                 {weights_.begin() + 1, weights_.end()}};
 }
 
@@ -56,17 +58,22 @@ double PrandtlIshlinskii::step(double x) noexcept {
 
 void PrandtlIshlinskii::apply(std::span<const double> x, std::span<double> y) noexcept {
   assert(x.size() == y.size());
-  for (std::size_t k = 0; k < x.size(); ++k) y[k] = step(x[k]);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    y[k] = step(x[k]);
 }
 
-double PrandtlIshlinskii::output() const noexcept { return kernels::dot(weights_, plays_); }
+double PrandtlIshlinskii::output() const noexcept {
+  return kernels::dot(weights_, plays_);
+}
 
 void PrandtlIshlinskii::set_state(std::span<const double> plays) noexcept {
   assert(plays.size() == plays_.size());
   std::copy(plays.begin(), plays.end(), plays_.begin());
 }
 
-void PrandtlIshlinskii::reset(double x) noexcept { std::fill(plays_.begin(), plays_.end(), x); }
+void PrandtlIshlinskii::reset(double x) noexcept {
+  std::fill(plays_.begin(), plays_.end(), x);
+}
 
 PrandtlIshlinskii PrandtlIshlinskii::inverse() const {
   PrandtlIshlinskii inv;

@@ -32,9 +32,9 @@ bool ThresholdCreep::Params::is_valid(std::string* why) const {
 ThresholdCreep::ThresholdCreep(Params params, double sample_time)
     : params_(std::move(params)), sample_time_(sample_time) {
   std::string why;
-  require_valid(params_.is_valid(&why) &&
-                    check::positive("ThresholdCreep.sample_time", sample_time, &why),
-                why);
+  require_valid(
+      params_.is_valid(&why) && check::positive("ThresholdCreep.sample_time", sample_time, &why),
+      why);
   const std::size_t rows = params_.thresholds.size();
   const std::size_t cols = params_.eigenvalues.size();
   gains_.resize(rows * cols);
@@ -54,16 +54,17 @@ double ThresholdCreep::step(double x) noexcept {
   double sum = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const std::size_t row = i * cols;
-    sum += kernels::lag_bank_step(p[i], std::span(gains_).subspan(row, cols),
-                                  std::span(params_.weights).subspan(row, cols),
-                                  z.subspan(row, cols));
+    sum +=
+        kernels::lag_bank_step(p[i], std::span(gains_).subspan(row, cols),
+                               std::span(params_.weights).subspan(row, cols), z.subspan(row, cols));
   }
   return sum;
 }
 
 void ThresholdCreep::apply(std::span<const double> x, std::span<double> y) noexcept {
   assert(x.size() == y.size());
-  for (std::size_t k = 0; k < x.size(); ++k) y[k] = step(x[k]);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    y[k] = step(x[k]);
 }
 
 double ThresholdCreep::output() const noexcept {
@@ -75,11 +76,14 @@ void ThresholdCreep::set_state(std::span<const double> state) noexcept {
   std::copy(state.begin(), state.end(), state_.begin());
 }
 
-void ThresholdCreep::reset(double x) noexcept { std::fill(state_.begin(), state_.end(), x); }
+void ThresholdCreep::reset(double x) noexcept {
+  std::fill(state_.begin(), state_.end(), x);
+}
 
 void NonlinearCreep::apply(std::span<const double> x, std::span<double> y) noexcept {
   assert(x.size() == y.size());
-  for (std::size_t k = 0; k < x.size(); ++k) y[k] = step(x[k]);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    y[k] = step(x[k]);
 }
 
 ThresholdCreep::Params NonlinearCreep::as_threshold_creep() const {
@@ -92,7 +96,8 @@ ThresholdCreep::Params NonlinearCreep::as_threshold_creep() const {
   std::vector<double> w{h.linear_weight};
   w.insert(w.end(), h.weights.begin(), h.weights.end());
   for (const double wi : w) {
-    for (const double cj : l.weights) out.weights.push_back(wi * cj);
+    for (const double cj : l.weights)
+      out.weights.push_back(wi * cj);
   }
   std::string why;
   require_valid(out.is_valid(&why), "NonlinearCreep.as_threshold_creep: " + why);

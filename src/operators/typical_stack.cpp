@@ -25,7 +25,8 @@ HysteresisCreep::Params scaled_stack(const TypicalStackSize& size, double full_s
   // Play weights carry the hysteresis share of the gain, the linear term the rest.
   const double gain = full_scale / e_max;
   const double play_scale = size.plays > 0 ? hysteresis_share * 4.0 * gain / play_weight_sum : 0;
-  for (double& w : h.weights) w *= play_scale;
+  for (double& w : h.weights)
+    w *= play_scale;
   h.linear_weight = gain * (1.0 - 2.0 * hysteresis_share);
 
   DeadZoneSuperposition::Params s;
@@ -43,9 +44,9 @@ HysteresisCreep::Params scaled_stack(const TypicalStackSize& size, double full_s
   // c_j = creep_per_decade * gain / (lags per decade), shared among the creep thresholds.
   const double lags_per_decade =
       size.eigenvalues > 1 ? static_cast<double>(size.eigenvalues - 1) / 4.0 : 1.0;
-  c.weights.assign(c.thresholds.size() * c.eigenvalues.size(),
-                   creep_per_decade * gain / lags_per_decade /
-                       static_cast<double>(c.thresholds.size()));
+  c.weights.assign(
+      c.thresholds.size() * c.eigenvalues.size(),
+      creep_per_decade * gain / lags_per_decade / static_cast<double>(c.thresholds.size()));
   return HysteresisCreep::Params{h, s, c};
 }
 

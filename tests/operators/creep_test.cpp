@@ -50,7 +50,8 @@ TEST(NonlinearCreep, EqualsThresholdCreepWithRankOneWeights) {
   NonlinearCreep k(PrandtlIshlinskii(h), LinearCreep(sample_creep(), ts));
   ThresholdCreep elements(k.as_threshold_creep(), ts);
   const std::vector<double> x = test::random_walk(20000, -2.0, 2.0, 0.05, 5);
-  for (const double v : x) ASSERT_NEAR(k.step(v), elements.step(v), 1e-12);
+  for (const double v : x)
+    ASSERT_NEAR(k.step(v), elements.step(v), 1e-12);
 }
 
 TEST(ThresholdCreep, CreepDependsOnHistoryLikeHysteresis) {
@@ -58,8 +59,10 @@ TEST(ThresholdCreep, CreepDependsOnHistoryLikeHysteresis) {
   ThresholdCreep::Params p{{0.0, 0.5}, {10.0, 1.0}, {0.0, 0.0, 0.4, 0.4}};
   ThresholdCreep from_below(p, 1e-3);
   ThresholdCreep from_above(p, 1e-3);
-  for (const double v : test::through({0.0, 1.0}, 100)) from_below.step(v);
-  for (const double v : test::through({0.0, 2.0, 1.0}, 100)) from_above.step(v);
+  for (const double v : test::through({0.0, 1.0}, 100))
+    from_below.step(v);
+  for (const double v : test::through({0.0, 2.0, 1.0}, 100))
+    from_above.step(v);
   double a = 0.0;
   double b = 0.0;
   for (int k = 0; k < 20000; ++k) {
@@ -73,12 +76,15 @@ TEST(ThresholdCreep, CreepDependsOnHistoryLikeHysteresis) {
 TEST(ThresholdCreep, StateSaveAndRestore) {
   ThresholdCreep c({{0.0, 0.3}, {50.0, 2.0}, {0.1, 0.2, 0.3, 0.4}}, 1e-3);
   const std::vector<double> x = test::random_walk(3000, -1.0, 1.0, 0.05, 9);
-  for (std::size_t k = 0; k < 1500; ++k) c.step(x[k]);
+  for (std::size_t k = 0; k < 1500; ++k)
+    c.step(x[k]);
   const std::vector<double> saved(c.state().begin(), c.state().end());
   std::vector<double> first;
-  for (std::size_t k = 1500; k < x.size(); ++k) first.push_back(c.step(x[k]));
+  for (std::size_t k = 1500; k < x.size(); ++k)
+    first.push_back(c.step(x[k]));
   c.set_state(saved);
-  for (std::size_t k = 1500; k < x.size(); ++k) ASSERT_EQ(c.step(x[k]), first[k - 1500]);
+  for (std::size_t k = 1500; k < x.size(); ++k)
+    ASSERT_EQ(c.step(x[k]), first[k - 1500]);
 }
 
 }  // namespace

@@ -30,7 +30,8 @@ TEST(DeadZoneSuperposition, PiecewiseLinearWithTheConfiguredSlopes) {
 TEST(DeadZoneSuperposition, ClosedFormInverse) {
   const DeadZoneSuperposition s = sample();
   const DeadZoneSuperposition inv = s.inverse();
-  for (double y = -10.0; y <= 10.0; y += 0.01) {
+  for (int k = -1000; k <= 1000; ++k) {
+    const double y = 0.01 * k;
     ASSERT_NEAR(inv.evaluate(s.evaluate(y)), y, 1e-12 * (1.0 + std::abs(y)));
   }
 }

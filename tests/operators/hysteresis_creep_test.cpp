@@ -112,12 +112,15 @@ TEST(HysteresisCreep, TypicalStackHasRealisticHysteresisAndCreep) {
 TEST(HysteresisCreep, StateSaveAndRestore) {
   HysteresisCreep op(typical_stack_strain(with_creep_plays()), kTs);
   const std::vector<double> e = test::random_walk(4000, 0.0, 2e6, 3e4, 17);
-  for (std::size_t k = 0; k < 2000; ++k) op.step(e[k]);
+  for (std::size_t k = 0; k < 2000; ++k)
+    op.step(e[k]);
   const std::vector<double> saved(op.state().begin(), op.state().end());
   std::vector<double> first;
-  for (std::size_t k = 2000; k < e.size(); ++k) first.push_back(op.step(e[k]));
+  for (std::size_t k = 2000; k < e.size(); ++k)
+    first.push_back(op.step(e[k]));
   op.set_state(saved);
-  for (std::size_t k = 2000; k < e.size(); ++k) ASSERT_EQ(op.step(e[k]), first[k - 2000]);
+  for (std::size_t k = 2000; k < e.size(); ++k)
+    ASSERT_EQ(op.step(e[k]), first[k - 2000]);
 }
 
 }  // namespace

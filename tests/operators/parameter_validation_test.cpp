@@ -32,34 +32,67 @@ TEST(ParameterValidation, PlayAndStopThresholds) {
 
 TEST(ParameterValidation, PrandtlIshlinskii) {
   using P = PrandtlIshlinskii::Params;
-  expect_rejected([] { PrandtlIshlinskii h(P{1.0, {0.1, -0.2}, {0.1, 0.1}}); },
-                  "PrandtlIshlinskii.thresholds[1]");
-  expect_rejected([] { PrandtlIshlinskii h(P{1.0, {0.3, 0.2}, {0.1, 0.1}}); },
-                  "PrandtlIshlinskii.thresholds[1]: 0.2 must be > PrandtlIshlinskii.thresholds[0]");
-  expect_rejected([] { PrandtlIshlinskii h(P{1.0, {0.0}, {0.1}}); },
-                  "PrandtlIshlinskii.thresholds[0]");
+  expect_rejected(
+      [] {
+        PrandtlIshlinskii h(P{1.0, {0.1, -0.2}, {0.1, 0.1}});
+      },
+      "PrandtlIshlinskii.thresholds[1]");
+  expect_rejected(
+      [] {
+        PrandtlIshlinskii h(P{1.0, {0.3, 0.2}, {0.1, 0.1}});
+      },
+      "PrandtlIshlinskii.thresholds[1]: 0.2 must be > PrandtlIshlinskii.thresholds[0]");
+  expect_rejected(
+      [] {
+        PrandtlIshlinskii h(P{1.0, {0.0}, {0.1}});
+      },
+      "PrandtlIshlinskii.thresholds[0]");
   expect_rejected([] { PrandtlIshlinskii h(P{0.0, {}, {}}); }, "PrandtlIshlinskii.linear_weight");
-  expect_rejected([] { PrandtlIshlinskii h(P{1.0, {0.1, 0.2}, {-0.5, -0.6}}); },
-                  "PrandtlIshlinskii.weights[1]: partial sum");
-  expect_rejected([] { PrandtlIshlinskii h(P{1.0, {0.1}, {kNaN}}); },
-                  "PrandtlIshlinskii.weights[0]");
-  expect_rejected([] { PrandtlIshlinskii h(P{1.0, {kInf}, {0.1}}); },
-                  "PrandtlIshlinskii.thresholds[0]");
+  expect_rejected(
+      [] {
+        PrandtlIshlinskii h(P{1.0, {0.1, 0.2}, {-0.5, -0.6}});
+      },
+      "PrandtlIshlinskii.weights[1]: partial sum");
+  expect_rejected(
+      [] {
+        PrandtlIshlinskii h(P{1.0, {0.1}, {kNaN}});
+      },
+      "PrandtlIshlinskii.weights[0]");
+  expect_rejected(
+      [] {
+        PrandtlIshlinskii h(P{1.0, {kInf}, {0.1}});
+      },
+      "PrandtlIshlinskii.thresholds[0]");
   expect_rejected([] { PrandtlIshlinskii h(P{1.0, {0.1, 0.2}, {0.1}}); }, "has 2 elements");
 }
 
 TEST(ParameterValidation, DeadZoneSuperposition) {
   using S = DeadZoneSuperposition::Params;
-  expect_rejected([] { DeadZoneSuperposition s(S{1.0, {0.5}, {-1.5}, {}, {}}); },
-                  "DeadZoneSuperposition.upper_weights[0]: slope");
-  expect_rejected([] { DeadZoneSuperposition s(S{1.0, {}, {}, {0.5}, {0.1}}); },
-                  "DeadZoneSuperposition.lower_thresholds[0]: 0.5 must be < 0");
-  expect_rejected([] { DeadZoneSuperposition s(S{1.0, {}, {}, {-0.5, -0.2}, {0.1, 0.1}}); },
-                  "DeadZoneSuperposition.lower_thresholds[1]");
-  expect_rejected([] { DeadZoneSuperposition s(S{-1.0, {}, {}, {}, {}}); },
-                  "DeadZoneSuperposition.linear_weight");
-  expect_rejected([] { DeadZoneSuperposition s(S{1.0, {1.0, 0.5}, {0.1, 0.1}, {}, {}}); },
-                  "DeadZoneSuperposition.upper_thresholds[1]");
+  expect_rejected(
+      [] {
+        DeadZoneSuperposition s(S{1.0, {0.5}, {-1.5}, {}, {}});
+      },
+      "DeadZoneSuperposition.upper_weights[0]: slope");
+  expect_rejected(
+      [] {
+        DeadZoneSuperposition s(S{1.0, {}, {}, {0.5}, {0.1}});
+      },
+      "DeadZoneSuperposition.lower_thresholds[0]: 0.5 must be < 0");
+  expect_rejected(
+      [] {
+        DeadZoneSuperposition s(S{1.0, {}, {}, {-0.5, -0.2}, {0.1, 0.1}});
+      },
+      "DeadZoneSuperposition.lower_thresholds[1]");
+  expect_rejected(
+      [] {
+        DeadZoneSuperposition s(S{-1.0, {}, {}, {}, {}});
+      },
+      "DeadZoneSuperposition.linear_weight");
+  expect_rejected(
+      [] {
+        DeadZoneSuperposition s(S{1.0, {1.0, 0.5}, {0.1, 0.1}, {}, {}});
+      },
+      "DeadZoneSuperposition.upper_thresholds[1]");
 }
 
 TEST(ParameterValidation, Creep) {
@@ -69,12 +102,21 @@ TEST(ParameterValidation, Creep) {
   expect_rejected([] { LinearCreep c(L{{1.0}, {0.1}}, 0.0); }, "LinearCreep.sample_time");
   expect_rejected([] { LinearCreep c(L{{1.0, 2.0}, {0.1}}, 1e-3); }, "LinearCreep.eigenvalues");
   using T = ThresholdCreep::Params;
-  expect_rejected([] { ThresholdCreep c(T{{0.0, 0.5}, {1.0}, {0.1}}, 1e-3); },
-                  "ThresholdCreep.weights has 1 elements");
-  expect_rejected([] { ThresholdCreep c(T{{-0.5}, {1.0}, {0.1}}, 1e-3); },
-                  "ThresholdCreep.thresholds[0]");
-  expect_rejected([] { ThresholdCreep c(T{{0.0}, {kNaN}, {0.1}}, 1e-3); },
-                  "ThresholdCreep.eigenvalues[0]");
+  expect_rejected(
+      [] {
+        ThresholdCreep c(T{{0.0, 0.5}, {1.0}, {0.1}}, 1e-3);
+      },
+      "ThresholdCreep.weights has 1 elements");
+  expect_rejected(
+      [] {
+        ThresholdCreep c(T{{-0.5}, {1.0}, {0.1}}, 1e-3);
+      },
+      "ThresholdCreep.thresholds[0]");
+  expect_rejected(
+      [] {
+        ThresholdCreep c(T{{0.0}, {kNaN}, {0.1}}, 1e-3);
+      },
+      "ThresholdCreep.eigenvalues[0]");
   expect_rejected([] { static_cast<void>(log_spaced_eigenvalues(1.0, 10.0, 3)); },
                   "fastest must be > slowest");
 }
@@ -82,7 +124,8 @@ TEST(ParameterValidation, Creep) {
 TEST(ParameterValidation, HysteresisCreepNamesThePart) {
   HysteresisCreep::Params p;
   p.creep = {{0.0}, {1.0}, {-0.2}};
-  expect_rejected([&] { HysteresisCreep h(p, 1e-3); }, "HysteresisCreep.creep.ThresholdCreep.weights[0]");
+  expect_rejected([&] { HysteresisCreep h(p, 1e-3); },
+                  "HysteresisCreep.creep.ThresholdCreep.weights[0]");
   p = HysteresisCreep::Params{};
   p.hysteresis.linear_weight = kNaN;
   expect_rejected([&] { HysteresisCreep h(p, 1e-3); }, "HysteresisCreep.hysteresis.");
@@ -94,8 +137,8 @@ TEST(ParameterValidation, HysteresisCreepNamesThePart) {
   // Eq. (28) with a negative PI weight would need negative creep weights.
   expect_rejected(
       [] {
-        static_cast<void>(HysteresisCreep::with_nonlinear_creep({1.0, {0.1}, {-0.5}}, {},
-                                                                {{1.0}, {0.1}}));
+        static_cast<void>(
+            HysteresisCreep::with_nonlinear_creep({1.0, {0.1}, {-0.5}}, {}, {{1.0}, {0.1}}));
       },
       "negative");
 }

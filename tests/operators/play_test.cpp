@@ -50,7 +50,8 @@ TEST(PlayOperator, BatchEqualsSteps) {
   PlayOperator b(0.3);
   std::vector<double> y(x.size());
   a.apply(x, y);
-  for (std::size_t k = 0; k < x.size(); ++k) ASSERT_EQ(y[k], b.step(x[k]));
+  for (std::size_t k = 0; k < x.size(); ++k)
+    ASSERT_EQ(y[k], b.step(x[k]));
 }
 
 }  // namespace

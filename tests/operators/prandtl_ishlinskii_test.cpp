@@ -35,7 +35,8 @@ DeadZoneSuperposition::Params sample_shape() {
 
 double max_abs(const std::vector<double>& v) {
   double m = 0.0;
-  for (const double x : v) m = std::max(m, std::abs(x));
+  for (const double x : v)
+    m = std::max(m, std::abs(x));
   return m;
 }
 
@@ -43,7 +44,8 @@ double max_abs(const std::vector<double>& v) {
 double final_output(const PrandtlIshlinskii::Params& params, const std::vector<double>& x) {
   PrandtlIshlinskii h(params);
   double y = 0.0;
-  for (const double v : x) y = h.step(v);
+  for (const double v : x)
+    y = h.step(v);
   return y;
 }
 
@@ -67,11 +69,13 @@ TEST(PrandtlIshlinskii, RateIndependent) {
 TEST(PrandtlIshlinskii, WipingOut) {
   // A minor loop inside (-0.2, 1.0) is erased once the input exceeds its earlier maximum.
   const PrandtlIshlinskii::Params params = sample_pi(20);
-  const double with_minor = final_output(params, test::through({0.0, 1.0, -0.5, 0.6, 0.1, 1.4}, 50));
+  const double with_minor =
+      final_output(params, test::through({0.0, 1.0, -0.5, 0.6, 0.1, 1.4}, 50));
   const double without = final_output(params, test::through({0.0, 1.0, -0.5, 1.4}, 50));
   EXPECT_NEAR(with_minor, without, 1e-12);
   // And the minor loop does matter before it is wiped out.
-  const double inside_minor = final_output(params, test::through({0.0, 1.0, -0.5, 0.6, 0.1, 0.5}, 50));
+  const double inside_minor =
+      final_output(params, test::through({0.0, 1.0, -0.5, 0.6, 0.1, 0.5}, 50));
   const double inside_plain = final_output(params, test::through({0.0, 1.0, -0.5, 0.5}, 50));
   EXPECT_GT(std::abs(inside_minor - inside_plain), 1e-3);
 }
@@ -83,18 +87,21 @@ TEST(PrandtlIshlinskii, MinorLoopsAreCongruent) {
   const std::vector<double> cycle = test::through({0.2, 0.7, 0.2}, 40);
   auto loop_after = [&](const std::vector<double>& history) {
     PrandtlIshlinskii h(params);
-    for (const double v : history) h.step(v);
+    for (const double v : history)
+      h.step(v);
     // One settling cycle, then record.
-    for (const double v : cycle) h.step(v);
-    std::vector<double> y;
-    for (const double v : cycle) y.push_back(h.step(v));
+    for (const double v : cycle)
+      h.step(v);
+    std::vector<double> y(cycle.size());
+    h.apply(cycle, y);
     return y;
   };
   const std::vector<double> a = loop_after(test::through({0.0, 1.5, 0.2}, 30));
   const std::vector<double> b = loop_after(test::through({0.0, -1.2, 0.9, 0.2}, 30));
   const double shift = a.front() - b.front();
   EXPECT_GT(std::abs(shift), 1e-3);  // different histories give different levels
-  for (std::size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(a[k] - b[k], shift, 1e-12);
+  for (std::size_t k = 0; k < a.size(); ++k)
+    EXPECT_NEAR(a[k] - b[k], shift, 1e-12);
 }
 
 TEST(PrandtlIshlinskii, InverseRoundTripOnRandomWalk) {
@@ -102,10 +109,12 @@ TEST(PrandtlIshlinskii, InverseRoundTripOnRandomWalk) {
   const std::vector<double> x = test::random_walk(100000, -4.0, 4.0, 0.05, 11);
   PrandtlIshlinskii h(params);
   // Start from a remanent state, not from zero.
-  for (const double v : test::through({0.0, 3.0, -1.0, 0.5}, 20)) h.step(v);
+  for (const double v : test::through({0.0, 3.0, -1.0, 0.5}, 20))
+    h.step(v);
   PrandtlIshlinskii h_inv = h.inverse();
   double worst = 0.0;
-  for (const double v : x) worst = std::max(worst, std::abs(h_inv.step(h.step(v)) - v));
+  for (const double v : x)
+    worst = std::max(worst, std::abs(h_inv.step(h.step(v)) - v));
   EXPECT_LE(worst, 1e-9 * max_abs(x));
 }
 
@@ -126,11 +135,13 @@ TEST(PrandtlIshlinskii, InverseIsAgainAPrandtlIshlinskiiOperator) {
 TEST(ModifiedPrandtlIshlinskii, InverseRoundTripOnRandomWalk) {
   ModifiedPrandtlIshlinskii gamma(PrandtlIshlinskii(sample_pi(32)),
                                   DeadZoneSuperposition(sample_shape()));
-  for (const double v : test::through({0.0, -2.0, 1.0}, 20)) gamma.step(v);
+  for (const double v : test::through({0.0, -2.0, 1.0}, 20))
+    gamma.step(v);
   ModifiedPrandtlIshlinskiiInverse gamma_inv = gamma.inverse();
   const std::vector<double> x = test::random_walk(100000, -4.0, 4.0, 0.05, 12);
   double worst = 0.0;
-  for (const double v : x) worst = std::max(worst, std::abs(gamma_inv.step(gamma.step(v)) - v));
+  for (const double v : x)
+    worst = std::max(worst, std::abs(gamma_inv.step(gamma.step(v)) - v));
   EXPECT_LE(worst, 1e-9 * max_abs(x));
 }
 
@@ -138,7 +149,8 @@ TEST(ModifiedPrandtlIshlinskii, LoopsAreAsymmetric) {
   ModifiedPrandtlIshlinskii gamma(PrandtlIshlinskii(sample_pi(20)),
                                   DeadZoneSuperposition(sample_shape()));
   std::vector<double> y;
-  for (const double v : test::through({0.0, 2.0, -2.0, 2.0}, 100)) y.push_back(gamma.step(v));
+  for (const double v : test::through({0.0, 2.0, -2.0, 2.0}, 100))
+    y.push_back(gamma.step(v));
   const double top = *std::max_element(y.begin(), y.end());
   const double bottom = *std::min_element(y.begin(), y.end());
   EXPECT_GT(std::abs(top + bottom), 0.05 * (top - bottom));  // not point-symmetric
@@ -147,12 +159,15 @@ TEST(ModifiedPrandtlIshlinskii, LoopsAreAsymmetric) {
 TEST(PrandtlIshlinskii, StateSaveAndRestoreReproducesOutput) {
   PrandtlIshlinskii h(sample_pi(16));
   const std::vector<double> x = test::random_walk(2000, -2.0, 2.0, 0.1, 3);
-  for (std::size_t k = 0; k < 1000; ++k) h.step(x[k]);
+  for (std::size_t k = 0; k < 1000; ++k)
+    h.step(x[k]);
   const std::vector<double> saved(h.state().begin(), h.state().end());
   std::vector<double> first;
-  for (std::size_t k = 1000; k < x.size(); ++k) first.push_back(h.step(x[k]));
+  for (std::size_t k = 1000; k < x.size(); ++k)
+    first.push_back(h.step(x[k]));
   h.set_state(saved);
-  for (std::size_t k = 1000; k < x.size(); ++k) ASSERT_EQ(h.step(x[k]), first[k - 1000]);
+  for (std::size_t k = 1000; k < x.size(); ++k)
+    ASSERT_EQ(h.step(x[k]), first[k - 1000]);
 }
 
 }  // namespace

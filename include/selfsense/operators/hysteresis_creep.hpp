@@ -76,9 +76,7 @@ class HysteresisCreep final {
 
  private:
   [[nodiscard]] std::size_t play_count() const noexcept { return thresholds_.size(); }
-  [[nodiscard]] std::span<double> plays() noexcept {
-    return std::span(state_).first(play_count());
-  }
+  [[nodiscard]] std::span<double> plays() noexcept { return std::span(state_).first(play_count()); }
   [[nodiscard]] std::span<double> lags() noexcept {
     return std::span(state_).subspan(play_count());
   }

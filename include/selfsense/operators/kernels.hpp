@@ -19,14 +19,16 @@ inline void play_bank_step(double x, std::span<const double> thresholds,
   const std::size_t n = thresholds.size();
   const double* r = thresholds.data();
   double* p = outputs.data();
-  for (std::size_t i = 0; i < n; ++i) p[i] = std::min(std::max(p[i], x - r[i]), x + r[i]);
+  for (std::size_t i = 0; i < n; ++i)
+    p[i] = std::min(std::max(p[i], x - r[i]), x + r[i]);
 }
 
 // sum_i w_i * v_i.
 inline double dot(std::span<const double> weights, std::span<const double> values) noexcept {
   assert(weights.size() == values.size());
   double sum = 0.0;
-  for (std::size_t i = 0; i < weights.size(); ++i) sum += weights[i] * values[i];
+  for (std::size_t i = 0; i < weights.size(); ++i)
+    sum += weights[i] * values[i];
   return sum;
 }
 

@@ -10,10 +10,10 @@
 namespace selfsense::operators {
 
 struct TypicalStackSize {
-  std::size_t plays{16};        // play operators besides the linear term
-  std::size_t dead_zones{4};    // upper dead zones of the superposition
-  std::size_t eigenvalues{5};   // creep lags, log-spaced from 100 1/s to 0.01 1/s
-  std::size_t creep_plays{0};   // creep elements on plays besides r = 0 (0: linear creep)
+  std::size_t plays{16};       // play operators besides the linear term
+  std::size_t dead_zones{4};   // upper dead zones of the superposition
+  std::size_t eigenvalues{5};  // creep lags, log-spaced from 100 1/s to 0.01 1/s
+  std::size_t creep_plays{0};  // creep elements on plays besides r = 0 (0: linear creep)
 };
 
 inline constexpr double kTypicalFieldMax = 2e6;  // V/m
