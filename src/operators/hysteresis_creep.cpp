@@ -156,6 +156,18 @@ void HysteresisCreep::reset(double x) noexcept {
   std::fill(state_.begin(), state_.end(), x);
 }
 
+void HysteresisCreep::set_history(std::span<const double> turning_points) noexcept {
+  reset(turning_points.empty() ? 0.0 : turning_points.front());
+  for (const double x : turning_points)
+    kernels::play_bank_step(x, thresholds_, plays());
+  const std::span<double> p = plays();
+  const std::span<double> z = lags();
+  const std::size_t cols = params_.creep.eigenvalues.size();
+  for (std::size_t i = 0; i < creep_rows_.size(); ++i) {
+    std::fill_n(z.begin() + static_cast<std::ptrdiff_t>(i * cols), cols, p[creep_rows_[i]]);
+  }
+}
+
 HysteresisCreepCompensator::HysteresisCreepCompensator(HysteresisCreep model, double input_min,
                                                        double input_max)
     : model_(std::move(model)), input_min_(input_min), input_max_(input_max) {

@@ -71,6 +71,9 @@ class HysteresisCreep final {
   void set_state(std::span<const double> state) noexcept;
   // Equilibrium at a constant input x (all plays and lags at x).
   void reset(double x = 0.0) noexcept;
+  // Remanent state: the plays after the input went through these turning points (from rest at
+  // the first), every creep lag settled at its play. Empty: reset(0).
+  void set_history(std::span<const double> turning_points) noexcept;
   // Union of hysteresis and creep thresholds, r_0 = 0 first: what the play states refer to.
   [[nodiscard]] std::span<const double> play_thresholds() const noexcept { return thresholds_; }
 

@@ -1,0 +1,68 @@
+// Identification of a hysteresis-creep operator with linear side inputs from a recording.
+//
+//   y = S[ H[x] + K[x] ] + sum_k g_k u_k + offset
+//
+// H: PI operator (linear term + `plays` plays), K: creep elements (eigenvalues x creep
+// thresholds), S: dead-zone superposition, u_k: inputs that enter linearly (stress T for the
+// paper's eq. 26-27). Every transducer structure is a special case: no plays, no creep and no
+// dead zones is the linear model (5-6); dead zones alone a stored characteristic (9-13); x = D
+// and y = E the charge-driven model of Jones and Garcia (18).
+//
+// The fit is convex and deterministic (no random restarts):
+//  1. weights enter linearly; with the partial sums W_i = w_0 + ... + w_i as unknowns the
+//     invertibility condition W_i > 0 is a simple bound, creep weights are >= 0: a bounded
+//     least-squares problem on the normal equations (solve_bounded_least_squares);
+//  2. with dead zones, the inverse superposition S' = S^-1 is fitted in the same way on the
+//     equation error S'[y - g u - offset] = H[x] + K[x] (Kuhnen's modified-PI identification),
+//     with g and offset from step 1, and inverted in closed form;
+//  3. the remanent state before the first sample is chosen among candidate input histories
+//     (a previous extremum at a grid of levels) by the residual on the first part of the data.
+// Thresholds follow from the input's range, creep eigenvalues from the sample time and the
+// duration. Not real-time code.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "selfsense/operators/hysteresis_creep.hpp"
+
+namespace selfsense::identification {
+
+struct OperatorStructure {
+  std::size_t plays{0};            // play operators besides the linear term
+  std::size_t eigenvalues{0};      // creep lags; 0: no creep
+  std::size_t creep_plays{0};      // creep elements on plays besides r = 0
+  std::size_t dead_zones{0};       // per side of the superposition; 0: S = identity
+  double fastest_eigenvalue{0.0};  // [1/s]; 0: min(100, 0.1 / Ts)
+  double slowest_eigenvalue{0.0};  // [1/s]; 0: 3 / duration
+  bool estimate_history{true};     // false: start demagnetised at the first input
+  bool fit_offset{true};
+};
+
+struct OperatorSignals {
+  std::span<const double> input{};                       // x
+  std::vector<std::span<const double>> linear_inputs{};  // u_k
+  std::span<const double> output{};                      // y
+  double sample_time{0.0};                               // [s]
+};
+
+struct OperatorModel {
+  operators::HysteresisCreep::Params op{};
+  std::vector<double> linear_gains{};  // g_k
+  double offset{0.0};
+  std::vector<double> history{};  // input turning points before the first sample
+  double sample_time{0.0};
+};
+
+// Throws std::invalid_argument on empty or mismatched signals, a non-positive sample time or
+// a constant input.
+[[nodiscard]] OperatorModel fit_operator(const OperatorSignals& signals,
+                                         const OperatorStructure& structure);
+
+// y = model response to x and the linear inputs, starting from the model's history.
+void simulate_operator(const OperatorModel& model, std::span<const double> x,
+                       const std::vector<std::span<const double>>& linear_inputs,
+                       std::span<double> y);
+
+}  // namespace selfsense::identification
