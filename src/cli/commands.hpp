@@ -9,5 +9,6 @@ class App;
 namespace selfsense::cli {
 
 void add_demo_command(CLI::App& app);
+void add_plant_command(CLI::App& app);
 
 }  // namespace selfsense::cli

@@ -61,7 +61,8 @@ void run_demo(const DemoOptions& opt) {
   std::vector<double> e(n);
   std::vector<double> s(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const double phase = 2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(per_cycle);
+    const double phase =
+        2.0 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(per_cycle);
     e[k] = 0.5 * kTypicalFieldMax * (1.0 - std::cos(phase));
   }
   stack.apply(e, s);
@@ -109,14 +110,14 @@ void run_demo(const DemoOptions& opt) {
   double err_comp = 0.0;
   HysteresisCreep open_loop(params, ts);
   for (std::size_t k = 0; k < n; ++k) {
-    const double desired = 0.45 * stroke * (1.0 - std::cos(2.0 * std::numbers::pi *
-                                                           static_cast<double>(k) /
-                                                           static_cast<double>(per_cycle)));
+    const double desired = 0.45 * stroke *
+                           (1.0 - std::cos(2.0 * std::numbers::pi * static_cast<double>(k) /
+                                           static_cast<double>(per_cycle)));
     err_open = std::max(err_open, std::abs(open_loop.step(desired / gain) - desired));
     err_comp = std::max(err_comp, std::abs(plant.step(feedforward.step(desired)) - desired));
   }
-  std::printf("\nfeedforward on a %g Hz sine of %.1f um (max error over %d cycles):\n",
-              opt.sine_hz, 0.9 * stroke * kStackLength * kMicro, opt.cycles);
+  std::printf("\nfeedforward on a %g Hz sine of %.1f um (max error over %d cycles):\n", opt.sine_hz,
+              0.9 * stroke * kStackLength * kMicro, opt.cycles);
   std::printf("  linear gain only      %8.4f um = %6.2f %% of range\n",
               err_open * kStackLength * kMicro, 100.0 * err_open / (0.9 * stroke));
   std::printf("  inverse compensator   %8.2e um = %6.2e %% of range (model = plant here)\n",

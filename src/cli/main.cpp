@@ -9,6 +9,7 @@ int main(int argc, char** argv) {
   CLI::App app{"selfsense: self-sensing piezo actuator tools"};
   app.require_subcommand(1);
   selfsense::cli::add_demo_command(app);
+  selfsense::cli::add_plant_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

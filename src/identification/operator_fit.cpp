@@ -152,6 +152,20 @@ void place_dead_zones(Layout& layout, std::span<const double> inner, std::size_t
   }
 }
 
+// Samples until the input has come within 2 % of both its minimum and its maximum.
+std::size_t sweep_length(std::span<const double> x) {
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  const double margin = 0.02 * (*hi - *lo);
+  bool low = false;
+  bool high = false;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    low = low || x[k] <= *lo + margin;
+    high = high || x[k] >= *hi - margin;
+    if (low && high) return k + 1;
+  }
+  return x.size();
+}
+
 // Candidate input histories before the first sample x0: demagnetised at x0, or on the major
 // loop (rest at one extreme, then the other) with a last turning point a before x0.
 std::vector<std::vector<double>> history_candidates(std::span<const double> x) {
@@ -186,7 +200,7 @@ std::vector<double> refine_turning_point(std::vector<double> h, double step, Res
   double d = a + kGolden * (b - a);
   double fc = at(c);
   double fd = at(d);
-  for (int i = 0; i < 14; ++i) {
+  for (int i = 0; i < 10; ++i) {
     if (fc < fd) {
       b = d;
       d = c;
@@ -263,12 +277,15 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
   // last turning point then refined by golden-section search between the grid neighbours.
   std::vector<double> history{signals.input.front()};
   if (structure.estimate_history && structure.plays > 0) {
-    const std::size_t head = std::min(n, std::max<std::size_t>(n / 5, 2000));
+    // The start state matters until the input has swept its whole range (wiping-out), so
+    // twice that span decides between candidates.
+    const std::size_t head =
+        std::min(n, std::max<std::size_t>(2 * sweep_length(signals.input), 2000));
     const auto residual = [&](const std::vector<double>& candidate) {
       const GramAccumulator acc = accumulate(layout, signals, {}, candidate, head);
       return solve(layout, acc, weight_floor).residual_sum_of_squares;
     };
-    // Grid first, then refine the three best grid candidates (rising and falling starts can
+    // Grid first, then refine the two best grid candidates (rising and falling starts can
     // be close) and keep the best refined one.
     std::vector<std::pair<double, std::vector<double>>> ranked;
     for (std::vector<double>& candidate : history_candidates(signals.input)) {
@@ -277,7 +294,7 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
     std::sort(ranked.begin(), ranked.end(),
               [](const auto& l, const auto& r) { return l.first < r.first; });
     double best = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < std::min<std::size_t>(3, ranked.size()); ++i) {
+    for (std::size_t i = 0; i < std::min<std::size_t>(2, ranked.size()); ++i) {
       std::vector<double> candidate = ranked[i].second;
       if (candidate.size() > 1)
         candidate = refine_turning_point(candidate, x_range / 8.0, residual);

@@ -31,13 +31,17 @@ class Recording final {
   [[nodiscard]] std::size_t rows() const noexcept;
   [[nodiscard]] std::size_t cols() const noexcept { return names_.size(); }
   [[nodiscard]] const std::vector<std::string>& names() const noexcept { return names_; }
-  [[nodiscard]] bool has(std::string_view name) const noexcept { return index_of(name).has_value(); }
+  [[nodiscard]] bool has(std::string_view name) const noexcept {
+    return index_of(name).has_value();
+  }
   [[nodiscard]] std::optional<std::size_t> index_of(std::string_view name) const noexcept;
 
   // The column's samples; throws RecordingError naming the column if it is absent.
   [[nodiscard]] std::span<const double> column(std::string_view name) const;
   [[nodiscard]] std::span<double> column(std::string_view name);
-  [[nodiscard]] std::span<const double> column(std::size_t index) const { return columns_.at(index); }
+  [[nodiscard]] std::span<const double> column(std::size_t index) const {
+    return columns_.at(index);
+  }
 
   // Appends a column, or replaces the values of an existing one of that name. Throws
   // std::invalid_argument if its length differs from the recording's row count.

@@ -1,0 +1,198 @@
+#include "selfsense/io/yaml_map.hpp"
+
+#include <cmath>
+#include <utility>
+
+namespace selfsense::io {
+
+namespace {
+
+int line_of(const YAML::Node& node) {
+  const YAML::Mark mark = node.Mark();
+  return mark.line >= 0 ? mark.line + 1 : 0;
+}
+
+std::string describe(const YAML::Node& node) {
+  if (node.IsNull()) return "null";
+  if (node.IsSequence()) return "a sequence";
+  if (node.IsMap()) return "a mapping";
+  return "'" + node.Scalar() + "'";
+}
+
+// `where` is "file:line: path".
+[[noreturn]] void type_error(const YAML::Node& node, const std::string& where,
+                             const std::string& expected) {
+  throw YamlError{where + ": expected " + expected + ", got " + describe(node)};
+}
+
+template <typename T>
+void convert(const YAML::Node& node, const std::string& where, const std::string& expected,
+             T& out) {
+  if (!node.IsScalar()) type_error(node, where, expected);
+  try {
+    out = node.as<T>();
+  } catch (const YAML::Exception&) {
+    type_error(node, where, expected);
+  }
+}
+
+}  // namespace
+
+void from_yaml(const YAML::Node& node, const std::string& where, double& out) {
+  convert(node, where, "a number", out);
+  if (!std::isfinite(out)) type_error(node, where, "a finite number");
+}
+void from_yaml(const YAML::Node& node, const std::string& where, int& out) {
+  convert(node, where, "an integer", out);
+}
+void from_yaml(const YAML::Node& node, const std::string& where, std::int64_t& out) {
+  convert(node, where, "an integer", out);
+}
+void from_yaml(const YAML::Node& node, const std::string& where, std::uint64_t& out) {
+  if (node.IsScalar() && !node.Scalar().empty() && node.Scalar().front() == '-') {
+    type_error(node, where, "a non-negative integer");
+  }
+  convert(node, where, "a non-negative integer", out);
+}
+void from_yaml(const YAML::Node& node, const std::string& where, bool& out) {
+  convert(node, where, "true or false", out);
+}
+void from_yaml(const YAML::Node& node, const std::string& where, std::string& out) {
+  convert(node, where, "a string", out);
+}
+
+YamlMap::YamlMap(const YAML::Node& node, std::string path, std::shared_ptr<Context> context)
+    : node_{node}, path_{std::move(path)}, context_{std::move(context)} {}
+
+YamlMap YamlMap::from_string(const std::string& text, const std::string& source) {
+  auto context = std::make_shared<Context>();
+  context->source = source;
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw YamlError{source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg};
+  }
+  if (!root.IsMap()) {
+    throw YamlError{source + ":1: the document must be a mapping of keys to values"};
+  }
+  return YamlMap{root, "", context};
+}
+
+YamlMap YamlMap::load_file(const std::filesystem::path& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path.string());
+  } catch (const YAML::BadFile&) {
+    throw YamlError{path.string() + ": cannot open the file"};
+  } catch (const YAML::ParserException& e) {
+    throw YamlError{path.string() + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg};
+  }
+  if (!root.IsMap()) {
+    throw YamlError{path.string() + ":1: the document must be a mapping of keys to values"};
+  }
+  auto context = std::make_shared<Context>();
+  context->source = path.string();
+  return YamlMap{root, "", context};
+}
+
+std::string YamlMap::path(std::string_view key) const {
+  return path_.empty() ? std::string{key} : path_ + "." + std::string{key};
+}
+
+bool YamlMap::has(std::string_view key) const {
+  for (const auto& pair : node_) {
+    if (pair.first.Scalar() == key) return true;
+  }
+  return false;
+}
+
+YAML::Node YamlMap::take(std::string_view key, bool required) {
+  for (const auto& pair : node_) {
+    if (pair.first.Scalar() != key) continue;
+    consumed_.emplace(key);
+    context_->lines.emplace(path(key), line_of(pair.first));
+    return pair.second;
+  }
+  if (required) fail(key, "required key is missing");
+  return YAML::Node{YAML::NodeType::Undefined};
+}
+
+std::string YamlMap::where(std::string_view key, const YAML::Node& node) const {
+  return context_->source + ":" + std::to_string(line_of(node)) + ": " + path(key);
+}
+
+std::string YamlMap::where_item(std::string_view key, std::size_t index,
+                                const YAML::Node& node) const {
+  const std::string item = path(key) + "[" + std::to_string(index) + "]";
+  context_->lines.emplace(item, line_of(node));
+  return context_->source + ":" + std::to_string(line_of(node)) + ": " + item;
+}
+
+void YamlMap::fail_at(const YAML::Node& node, const std::string& path,
+                      const std::string& message) const {
+  throw YamlError{context_->source + ":" + std::to_string(line_of(node)) + ": " + path + ": " +
+                  message};
+}
+
+void YamlMap::fail(std::string_view key, const std::string& message) const {
+  for (const auto& pair : node_) {
+    if (pair.first.Scalar() == key) fail_at(pair.first, path(key), message);
+  }
+  fail_at(node_, path(key), message);
+}
+
+YamlMap YamlMap::map(std::string_view key) {
+  const YAML::Node node = take(key, true);
+  if (!node.IsMap()) fail_at(node, path(key), "expected a mapping, got " + describe(node));
+  return YamlMap{node, path(key), context_};
+}
+
+std::optional<YamlMap> YamlMap::optional_map(std::string_view key) {
+  const YAML::Node node = take(key, false);
+  if (!node) return std::nullopt;
+  if (!node.IsMap()) fail_at(node, path(key), "expected a mapping, got " + describe(node));
+  return YamlMap{node, path(key), context_};
+}
+
+std::vector<YamlMap> YamlMap::maps(std::string_view key) {
+  const YAML::Node node = take(key, false);
+  std::vector<YamlMap> out;
+  if (!node) return out;
+  if (!node.IsSequence()) fail_at(node, path(key), "expected a sequence, got " + describe(node));
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const YAML::Node item = node[i];
+    const std::string item_path = path(key) + "[" + std::to_string(i) + "]";
+    if (!item.IsMap()) fail_at(item, item_path, "expected a mapping, got " + describe(item));
+    context_->lines.emplace(item_path, line_of(item));
+    out.push_back(YamlMap{item, item_path, context_});
+  }
+  return out;
+}
+
+void YamlMap::finish() const {
+  std::set<std::string, std::less<>> seen;
+  for (const auto& pair : node_) {
+    const std::string& key = pair.first.Scalar();
+    if (!seen.insert(key).second) fail_at(pair.first, path(key), "duplicate key");
+    if (!consumed_.contains(key)) fail_at(pair.first, path(key), "unknown key");
+  }
+}
+
+std::string YamlMap::locate(const std::string& message) const {
+  // The longest recorded key path that the message starts with, followed by ':' or '['.
+  std::string best;
+  int line = 0;
+  for (const auto& [key, key_line] : context_->lines) {
+    if (message.size() > key.size() && message.compare(0, key.size(), key) == 0 &&
+        (message[key.size()] == ':' || message[key.size()] == '[' || message[key.size()] == '.') &&
+        key.size() > best.size()) {
+      best = key;
+      line = key_line;
+    }
+  }
+  if (best.empty()) return context_->source + ": " + message;
+  return context_->source + ":" + std::to_string(line) + ": " + message;
+}
+
+}  // namespace selfsense::io

@@ -1,0 +1,136 @@
+#include "selfsense/models/transducer_model.hpp"
+
+#include <array>
+#include <stdexcept>
+#include <utility>
+
+#include "selfsense/operators/parameter_error.hpp"
+
+namespace selfsense::models {
+namespace {
+
+constexpr std::array<std::pair<Structure, std::string_view>, 5> kNames{{
+    {Structure::kLinear, "linear"},
+    {Structure::kPermittivity, "permittivity"},
+    {Structure::kChargeDrive, "charge-drive"},
+    {Structure::kHysteresis, "hysteresis"},
+    {Structure::kHysteresisCreep, "hysteresis-creep"},
+}};
+
+bool side_valid(const char* name, const std::optional<SideModel>& side, double ts,
+                std::string* why) {
+  if (!side) return true;
+  std::string inner;
+  if (!side->op.is_valid(&inner)) {
+    if (why != nullptr) *why = std::string(name) + "." + inner;
+    return false;
+  }
+  if (side->sample_time != ts) {
+    if (why != nullptr) *why = std::string(name) + ".sample_time differs from sample_time";
+    return false;
+  }
+  for (const double g : side->linear_gains) {
+    if (!operators::check::finite(std::string(name) + ".coupling", g, why)) return false;
+  }
+  return operators::check::finite(std::string(name) + ".offset", side->offset, why);
+}
+
+identification::OperatorStructure structure_of(const IdentificationOptions& o, bool creep) {
+  identification::OperatorStructure s;
+  s.plays = o.plays;
+  s.eigenvalues = creep ? o.eigenvalues : 0;
+  s.creep_plays = creep ? o.creep_plays : 0;
+  s.dead_zones = o.dead_zones;
+  s.estimate_history = o.estimate_history;
+  return s;
+}
+
+}  // namespace
+
+std::string_view to_string(Structure s) noexcept {
+  for (const auto& [structure, name] : kNames) {
+    if (structure == s) return name;
+  }
+  return "unknown";
+}
+
+std::optional<Structure> parse_structure(std::string_view name) noexcept {
+  for (const auto& [structure, n] : kNames) {
+    if (n == name) return structure;
+  }
+  return std::nullopt;
+}
+
+std::string structure_names() {
+  std::string out;
+  for (const auto& [structure, name] : kNames) {
+    if (!out.empty()) out += ", ";
+    out += name;
+  }
+  return out;
+}
+
+Drive drive_of(Structure s) noexcept {
+  return s == Structure::kChargeDrive ? Drive::kCharge : Drive::kField;
+}
+
+bool TransducerModel::is_valid(std::string* why) const {
+  if (!operators::check::positive("sample_time", sample_time, why)) return false;
+  if (!sensor && !actuator) {
+    if (why != nullptr) *why = "model: needs a sensor or an actuator side";
+    return false;
+  }
+  if (geometry && !geometry->is_valid(why)) return false;
+  return side_valid("sensor", sensor, sample_time, why) &&
+         side_valid("actuator", actuator, sample_time, why);
+}
+
+IdentificationOptions defaults_for(Structure s) noexcept {
+  switch (s) {
+    case Structure::kLinear:
+      return {};
+    case Structure::kPermittivity:
+      return {0, 0, 0, 8, false};
+    case Structure::kHysteresis:
+    case Structure::kChargeDrive:
+      return {24, 0, 0, 8, true};
+    case Structure::kHysteresisCreep:
+      return {24, 6, 2, 8, true};
+  }
+  return {};
+}
+
+TransducerModel identify(const TransducerSignals& signals, Structure structure,
+                         const IdentificationOptions& options) {
+  const std::size_t n = signals.drive.size();
+  const auto usable = [n](std::span<const double> s) { return !s.empty() && s.size() == n; };
+  if (n < 2) throw std::invalid_argument("identify: the drive signal needs at least 2 samples");
+  if (!usable(signals.sensed) && !usable(signals.strain)) {
+    throw std::invalid_argument("identify: needs the sensed channel or the strain to fit");
+  }
+  if (!signals.stress.empty() && signals.stress.size() != n) {
+    throw std::invalid_argument("identify: stress and drive differ in length");
+  }
+  TransducerModel model;
+  model.structure = structure;
+  model.sample_time = signals.sample_time;
+  std::vector<std::span<const double>> linear;
+  if (!signals.stress.empty()) linear.push_back(signals.stress);
+
+  const bool creep = structure == Structure::kHysteresisCreep;
+  if (usable(signals.sensed)) {
+    model.sensor = identification::fit_operator(
+        {signals.drive, linear, signals.sensed, signals.sample_time}, structure_of(options, creep));
+  }
+  if (usable(signals.strain)) {
+    // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19).
+    const bool linear_side =
+        structure == Structure::kPermittivity || structure == Structure::kChargeDrive;
+    model.actuator = identification::fit_operator(
+        {signals.drive, linear, signals.strain, signals.sample_time},
+        linear_side ? identification::OperatorStructure{} : structure_of(options, creep));
+  }
+  return model;
+}
+
+}  // namespace selfsense::models

@@ -1,0 +1,110 @@
+#include "selfsense/io/yaml_map.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace selfsense::io {
+namespace {
+
+std::string error_of(const auto& action) {
+  try {
+    action();
+  } catch (const YamlError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(YamlMap, TypedGettersRequiredOptionalAndDefaults) {
+  YamlMap root = YamlMap::from_string("a: 1.5\nb: 3\nc: true\nd: text\n", "C.yaml");
+  EXPECT_DOUBLE_EQ(root.required<double>("a"), 1.5);
+  EXPECT_EQ(root.optional<int>("b", 7), 3);
+  EXPECT_EQ(root.optional<int>("missing", 7), 7);
+  bool c = false;
+  root.read("c", c);
+  EXPECT_TRUE(c);
+  std::string d{"default"};
+  root.read("d", d);
+  EXPECT_EQ(d, "text");
+  EXPECT_NO_THROW(root.finish());
+}
+
+TEST(YamlMap, MissingRequiredKeyNamesThePath) {
+  YamlMap root = YamlMap::from_string("outer:\n  x: 1\n", "C.yaml");
+  YamlMap outer = root.map("outer");
+  EXPECT_EQ(error_of([&] { static_cast<void>(outer.required<double>("y")); }),
+            "C.yaml:2: outer.y: required key is missing");
+}
+
+TEST(YamlMap, UnknownKeysAreErrorsWithLine) {
+  YamlMap root = YamlMap::from_string("outer:\n  x: 1\n  typo: 2\n", "C.yaml");
+  YamlMap outer = root.map("outer");
+  static_cast<void>(outer.required<int>("x"));
+  EXPECT_EQ(error_of([&] { outer.finish(); }), "C.yaml:3: outer.typo: unknown key");
+  EXPECT_NO_THROW(root.finish());
+}
+
+TEST(YamlMap, DuplicateKeysAreErrors) {
+  YamlMap root = YamlMap::from_string("x: 1\nx: 2\n", "C.yaml");
+  static_cast<void>(root.required<int>("x"));
+  EXPECT_EQ(error_of([&] { root.finish(); }), "C.yaml:2: x: duplicate key");
+}
+
+TEST(YamlMap, WrongTypesNameTheKey) {
+  YamlMap root = YamlMap::from_string("n: abc\ni: 2.5\nb: maybe\nu: -3\nm: {a: 1}\n", "C.yaml");
+  EXPECT_EQ(error_of([&] { static_cast<void>(root.required<double>("n")); }),
+            "C.yaml:1: n: expected a number, got 'abc'");
+  EXPECT_EQ(error_of([&] { static_cast<void>(root.required<int>("i")); }),
+            "C.yaml:2: i: expected an integer, got '2.5'");
+  EXPECT_EQ(error_of([&] { static_cast<void>(root.required<bool>("b")); }),
+            "C.yaml:3: b: expected true or false, got 'maybe'");
+  EXPECT_EQ(error_of([&] { static_cast<void>(root.required<std::uint64_t>("u")); }),
+            "C.yaml:4: u: expected a non-negative integer, got '-3'");
+  EXPECT_EQ(error_of([&] { static_cast<void>(root.required<double>("m")); }),
+            "C.yaml:5: m: expected a number, got a mapping");
+}
+
+TEST(YamlMap, SequencesNameTheirElements) {
+  YamlMap root = YamlMap::from_string("tau_s: [1, 2, x]\nok: [1, 2]\nscalar: 3\n", "C.yaml");
+  std::vector<double> v{};
+  EXPECT_EQ(error_of([&] { root.read_sequence("tau_s", v); }),
+            "C.yaml:1: tau_s[2]: expected a number, got 'x'");
+  root.read_sequence("ok", v);
+  EXPECT_EQ(v, (std::vector<double>{1.0, 2.0}));
+  EXPECT_EQ(error_of([&] { root.read_sequence("scalar", v); }),
+            "C.yaml:3: scalar: expected a sequence");
+}
+
+TEST(YamlMap, SequencesOfMapsCarryIndexedPaths) {
+  YamlMap root = YamlMap::from_string("items:\n  - {a: 1}\n  - {a: 2, b: 3}\n", "C.yaml");
+  std::vector<YamlMap> items = root.maps("items");
+  ASSERT_EQ(items.size(), 2U);
+  EXPECT_EQ(items[1].path("b"), "items[1].b");
+  static_cast<void>(items[1].required<int>("a"));
+  EXPECT_EQ(error_of([&] { items[1].finish(); }), "C.yaml:3: items[1].b: unknown key");
+}
+
+TEST(YamlMap, LocateAddsTheLineOfAKeyReadEarlier) {
+  YamlMap root = YamlMap::from_string("plant:\n  x: 1\n  y:\n    z: 5\n", "C.yaml");
+  YamlMap plant = root.map("plant");
+  YamlMap y = plant.map("y");
+  static_cast<void>(y.required<int>("z"));
+  EXPECT_EQ(root.locate("plant.y.z: 5: too large"), "C.yaml:4: plant.y.z: 5: too large");
+  EXPECT_EQ(root.locate("other: bad"), "C.yaml: other: bad");
+}
+
+TEST(YamlMap, ParseErrorsAndNonMappingDocuments) {
+  EXPECT_NE(error_of([] {
+              static_cast<void>(YamlMap::from_string("a: [1, 2\n", "C.yaml"));
+            }).find("C.yaml:"),
+            std::string::npos);
+  EXPECT_EQ(error_of([] { static_cast<void>(YamlMap::from_string("- 1\n", "C.yaml")); }),
+            "C.yaml:1: the document must be a mapping of keys to values");
+  EXPECT_EQ(error_of([] { static_cast<void>(YamlMap::load_file("/nonexistent/x.yaml")); }),
+            "/nonexistent/x.yaml: cannot open the file");
+}
+
+}  // namespace
+}  // namespace selfsense::io

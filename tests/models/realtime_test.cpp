@@ -1,0 +1,38 @@
+// Real-time path proof for the model layer: reconstruction and forward steps never allocate.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "selfsense/models/reconstructor.hpp"
+#include "support/allocation_counter.hpp"
+#include "support/transducer_data.hpp"
+
+namespace selfsense::models {
+namespace {
+
+static_assert(noexcept(std::declval<Reconstructor&>().step(0.0, 0.0)));
+static_assert(noexcept(std::declval<ForwardModel&>().step(0.0, 0.0)));
+
+TEST(ModelRealTime, StepsAndStateSavesDoNotAllocate) {
+  const TransducerModel model = test::typical_transducer(1e-4);
+  const test::TransducerData d = test::transducer_data(model, 3000, 1e-4, 5);
+  Reconstructor r(model);
+  ForwardModel f(model);
+  std::vector<double> state(r.state_size());
+  double sink = 0.0;
+  test::AllocationCounter counter;
+  for (std::size_t k = 0; k < d.e.size(); ++k) {
+    const Reconstructor::Estimate est = r.step(d.e[k], d.d[k]);
+    const ForwardModel::Output out = f.step(d.e[k], est.stress);
+    r.save_state(state);
+    r.restore_state(state);
+    sink += est.strain + out.sensed;
+  }
+  EXPECT_EQ(counter.count(), 0U);
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+}  // namespace
+}  // namespace selfsense::models
