@@ -18,6 +18,7 @@ say() { printf '\n== %s\n' "$*"; }
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libyaml-cpp-dev libgpiod-dev libmodbus-dev libsystemd-dev libcli11-dev
+  nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
 )

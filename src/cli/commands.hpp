@@ -10,5 +10,8 @@ namespace selfsense::cli {
 
 void add_demo_command(CLI::App& app);
 void add_plant_command(CLI::App& app);
+void add_identify_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
+void add_reconstruct_command(CLI::App& app);
 
 }  // namespace selfsense::cli

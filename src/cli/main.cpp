@@ -10,6 +10,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   selfsense::cli::add_demo_command(app);
   selfsense::cli::add_plant_command(app);
+  selfsense::cli::add_identify_command(app);
+  selfsense::cli::add_simulate_command(app);
+  selfsense::cli::add_reconstruct_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -42,6 +42,8 @@ identification::OperatorStructure structure_of(const IdentificationOptions& o, b
   s.creep_plays = creep ? o.creep_plays : 0;
   s.dead_zones = o.dead_zones;
   s.estimate_history = o.estimate_history;
+  s.fastest_eigenvalue = o.fastest_eigenvalue;
+  s.slowest_eigenvalue = o.slowest_eigenvalue;
   return s;
 }
 
@@ -90,12 +92,12 @@ IdentificationOptions defaults_for(Structure s) noexcept {
     case Structure::kLinear:
       return {};
     case Structure::kPermittivity:
-      return {0, 0, 0, 8, false};
+      return {0, 0, 0, 8, false, 0.0, 0.0};
     case Structure::kHysteresis:
     case Structure::kChargeDrive:
-      return {24, 0, 0, 8, true};
+      return {24, 0, 0, 8, true, 0.0, 0.0};
     case Structure::kHysteresisCreep:
-      return {24, 6, 2, 8, true};
+      return {24, 6, 2, 8, true, 0.0, 0.0};
   }
   return {};
 }

@@ -55,7 +55,6 @@ Recording make_recording() {
 
 void BM_ReadRecordingCsv(benchmark::State& state, const fs::path& path) {
   const auto bytes = static_cast<std::int64_t>(fs::file_size(path));
-  // NOLINTNEXTLINE(clang-analyzer-deadcode.DeadStores): the loop variable of the benchmark idiom
   for (auto _ : state) {
     Recording recording = selfsense::io::read_recording_csv(path);
     benchmark::DoNotOptimize(recording);
@@ -66,7 +65,6 @@ void BM_ReadRecordingCsv(benchmark::State& state, const fs::path& path) {
 
 void BM_WriteRecordingCsv(benchmark::State& state, const Recording& recording,
                           const fs::path& path) {
-  // NOLINTNEXTLINE(clang-analyzer-deadcode.DeadStores): the loop variable of the benchmark idiom
   for (auto _ : state) {
     selfsense::io::write_recording_csv(recording, path);
   }

@@ -42,7 +42,6 @@ void run_steps(benchmark::State& state, const PlantConfig& config) {
   const std::vector<StepInput> in = inputs(config.sample_rate_hz);
   Plant plant{config};
   std::size_t k = 0;
-  // NOLINTNEXTLINE(clang-analyzer-deadcode.DeadStores): the loop variable of the benchmark idiom
   for (auto _ : state) {
     const StepOutput o = plant.step(in[k]);
     benchmark::DoNotOptimize(o);
@@ -64,7 +63,6 @@ void BM_PlantRunMillionSamples(benchmark::State& state) {
   std::vector<StepInput> in = inputs(config.sample_rate_hz);
   in.resize(1000000, in.back());
   std::vector<StepOutput> out(in.size());
-  // NOLINTNEXTLINE(clang-analyzer-deadcode.DeadStores): the loop variable of the benchmark idiom
   for (auto _ : state) {
     Plant plant{config};
     plant.run(in, out);

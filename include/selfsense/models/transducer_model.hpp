@@ -62,6 +62,8 @@ struct IdentificationOptions {
   std::size_t creep_plays{0};
   std::size_t dead_zones{0};
   bool estimate_history{true};
+  double fastest_eigenvalue{0.0};  // [1/s]; 0: from the sample time (OperatorStructure)
+  double slowest_eigenvalue{0.0};  // [1/s]; 0: from the duration
 };
 [[nodiscard]] IdentificationOptions defaults_for(Structure s) noexcept;
 

@@ -1,0 +1,170 @@
+// `selfsense identify`: fits a transducer model of a named structure to a recording with
+// reference channels, on its first part, and reports the fit on that part and on the held-out
+// rest (contracts.md).
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "commands.hpp"
+#include "field_signals.hpp"
+#include "model_runs.hpp"
+#include "selfsense/io/recording.hpp"
+#include "selfsense/io/yaml_map.hpp"
+#include "selfsense/models/model_yaml.hpp"
+
+namespace selfsense::cli {
+namespace {
+
+struct IdentifyOptions {
+  std::filesystem::path recording{};
+  std::string structure{};
+  std::filesystem::path out{};
+  std::filesystem::path json{};
+  std::filesystem::path geometry{};
+  double holdout{0.2};
+  int plays{-1};
+  int eigenvalues{-1};
+  int creep_plays{-1};
+  int dead_zones{-1};
+  double fastest{0.0};
+  double slowest{0.0};
+};
+
+models::Geometry load_geometry(const std::filesystem::path& path) {
+  io::YamlMap g = io::YamlMap::load_file(path);
+  models::Geometry geo;
+  geo.layer_thickness = g.required<double>("layer_thickness_m");
+  geo.electrode_area = g.required<double>("electrode_area_m2");
+  geo.layers = g.required<double>("layers");
+  geo.active_length = g.required<double>("active_length_m");
+  geo.cross_section = g.required<double>("cross_section_m2");
+  g.finish();
+  std::string why;
+  if (!geo.is_valid(&why)) throw io::YamlError(g.locate(why.substr(why.find('.') + 1)));
+  return geo;
+}
+
+void print_table(const std::vector<ChannelFigures>& fit, const std::vector<ChannelFigures>& held) {
+  std::printf("  channel   fit nrmse   fit max   held-out nrmse   held-out max\n");
+  for (std::size_t i = 0; i < fit.size(); ++i) {
+    std::printf("  %-7s %9.3f %% %7.3f %%", fit[i].channel.c_str(), 100.0 * fit[i].figures.nrmse,
+                100.0 * fit[i].figures.max);
+    if (i < held.size()) {
+      std::printf(" %14.3f %% %12.3f %%", 100.0 * held[i].figures.nrmse,
+                  100.0 * held[i].figures.max);
+    }
+    std::printf("\n");
+  }
+}
+
+void run_identify(const IdentifyOptions& opt) {
+  const std::optional<models::Structure> structure = models::parse_structure(opt.structure);
+  if (!structure) {
+    throw std::invalid_argument("--structure: '" + opt.structure + "' is not one of " +
+                                models::structure_names());
+  }
+  std::optional<models::Geometry> geometry;
+  if (!opt.geometry.empty()) geometry = load_geometry(opt.geometry);
+  const io::Recording rec = io::read_recording_csv(opt.recording, io::ReadOptions{{"t"}});
+  const FieldSignals signals =
+      field_signals(rec, opt.recording.string(), geometry, models::drive_of(*structure));
+  const models::Drive drive = models::drive_of(*structure);
+  const std::size_t n = signals.size();
+  const auto split = static_cast<std::size_t>(static_cast<double>(n) * (1.0 - opt.holdout));
+  if (split < 2) throw std::invalid_argument("--holdout leaves fewer than 2 samples to fit");
+
+  models::IdentificationOptions sizes = models::defaults_for(*structure);
+  if (opt.plays >= 0) sizes.plays = static_cast<std::size_t>(opt.plays);
+  if (opt.eigenvalues >= 0) sizes.eigenvalues = static_cast<std::size_t>(opt.eigenvalues);
+  if (opt.creep_plays >= 0) sizes.creep_plays = static_cast<std::size_t>(opt.creep_plays);
+  if (opt.dead_zones >= 0) sizes.dead_zones = static_cast<std::size_t>(opt.dead_zones);
+  sizes.fastest_eigenvalue = opt.fastest;
+  sizes.slowest_eigenvalue = opt.slowest;
+
+  const auto head = [split](const std::vector<double>& v) {
+    return v.empty() ? std::span<const double>{} : std::span<const double>(v).first(split);
+  };
+  const auto sensed = signals.sensed(drive);
+  const models::TransducerSignals part{head(drive == models::Drive::kField ? signals.e : signals.d),
+                                       sensed.empty() ? sensed : sensed.first(split),
+                                       head(signals.stress), head(signals.s), signals.sample_time};
+  if (sensed.empty())
+    std::printf("note: %s has no sensed channel: actuator side only\n", signals.source.c_str());
+  if (signals.stress.empty()) {
+    std::printf("note: %s has no T: free actuator assumed (T = 0); no stress reconstruction\n",
+                signals.source.c_str());
+  }
+  const auto start = std::chrono::steady_clock::now();
+  models::TransducerModel model = models::identify(part, *structure, sizes);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  model.geometry = geometry;
+
+  const ModelRuns runs = run_model(model, signals, true, true);
+  const std::vector<ChannelFigures> fit = figures(model, signals, runs, 0, split);
+  const std::vector<ChannelFigures> held = figures(model, signals, runs, split, n);
+  std::printf(
+      "selfsense identify: %s from %s (%zu samples, Ts %g s); fitted on the first %zu in "
+      "%.2f s\n",
+      opt.structure.c_str(), signals.source.c_str(), n, signals.sample_time, split, seconds);
+  print_table(fit, held);
+
+  nlohmann::json report = {{"structure", opt.structure},
+                           {"recording", opt.recording.string()},
+                           {"samples", n},
+                           {"fit_samples", split},
+                           {"sample_time_s", signals.sample_time},
+                           {"seconds", seconds},
+                           {"fit", to_json(fit)},
+                           {"held_out", to_json(held)}};
+  if (model.sensor) report["sensor_coupling"] = model.sensor->linear_gains.at(0);
+  if (model.actuator) report["actuator_coupling"] = model.actuator->linear_gains.at(0);
+  models::save_model(model, opt.out,
+                     "{fit: " + to_json(fit).dump() + ", held_out: " + to_json(held).dump() + "}");
+  std::printf("wrote %s\n", opt.out.string().c_str());
+  if (!opt.json.empty()) {
+    std::ofstream file(opt.json);
+    if (!file || !(file << report.dump(2) << '\n')) {
+      throw std::runtime_error(opt.json.string() + ": cannot write");
+    }
+    std::printf("wrote %s\n", opt.json.string().c_str());
+  }
+}
+
+}  // namespace
+
+void add_identify_command(CLI::App& app) {
+  auto opt = std::make_shared<IdentifyOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "identify", "Fit a transducer model of a structure to a recording with reference S and T");
+  cmd->add_option("--recording", opt->recording, "Recording (CSV)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--structure", opt->structure, models::structure_names())->required();
+  cmd->add_option("--out", opt->out, "Model to write (YAML)")->required();
+  cmd->add_option("--json", opt->json, "Fit figures to write (JSON)");
+  cmd->add_option("--geometry", opt->geometry, "Transducer geometry (YAML), for u, q, x, F columns")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--holdout", opt->holdout, "Share of the recording held out at its end")
+      ->check(CLI::Range(0.0, 0.9));
+  cmd->add_option("--plays", opt->plays, "Play operators (default per structure)")
+      ->check(CLI::Range(0, 512));
+  cmd->add_option("--eigenvalues", opt->eigenvalues, "Creep eigenvalues")->check(CLI::Range(0, 32));
+  cmd->add_option("--creep-plays", opt->creep_plays, "Creep elements on plays besides r = 0")
+      ->check(CLI::Range(0, 64));
+  cmd->add_option("--dead-zones", opt->dead_zones, "Dead zones per side")->check(CLI::Range(0, 64));
+  cmd->add_option("--fastest-eigenvalue", opt->fastest, "Fastest creep eigenvalue [1/s]")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--slowest-eigenvalue", opt->slowest, "Slowest creep eigenvalue [1/s]")
+      ->check(CLI::PositiveNumber);
+  cmd->callback([opt] { run_identify(*opt); });
+}
+
+}  // namespace selfsense::cli

@@ -1,0 +1,41 @@
+// Runs a transducer model over a whole recording (forward and reconstruction) and computes the
+// fit figures of contracts.md per channel.
+#pragma once
+
+#include <cstddef>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "field_signals.hpp"
+#include "selfsense/identification/fit_quality.hpp"
+#include "selfsense/models/transducer_model.hpp"
+
+namespace selfsense::cli {
+
+struct ModelRuns {
+  std::vector<double> sensed{};  // D_model (field drive) or E_model (charge drive)
+  std::vector<double> strain{};  // S_model
+  std::vector<double> stress_hat{};
+  std::vector<double> strain_hat{};
+};
+
+// Forward with the recorded stress (0 where the recording has none); reconstruction where the
+// model has a sensor side with a coupling and the recording the sensed channel.
+[[nodiscard]] ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& signals,
+                                  bool forward, bool reconstruct);
+
+struct ChannelFigures {
+  std::string channel{};  // D (or E), S, T_hat, S_hat
+  identification::FitQuality figures{};
+};
+
+// Figures on samples [from, to) of every channel that has both a model output and a reference.
+[[nodiscard]] std::vector<ChannelFigures> figures(const models::TransducerModel& model,
+                                                  const FieldSignals& signals,
+                                                  const ModelRuns& runs, std::size_t from,
+                                                  std::size_t to);
+
+[[nodiscard]] nlohmann::json to_json(const std::vector<ChannelFigures>& figures);
+
+}  // namespace selfsense::cli

@@ -1,0 +1,190 @@
+#include "selfsense/models/model_yaml.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <optional>
+#include <stdexcept>
+#include <string_view>
+#include <utility>
+
+#include "selfsense/io/yaml_map.hpp"
+
+namespace selfsense::models {
+namespace {
+
+using io::YamlMap;
+using operators::HysteresisCreep;
+
+// Validation messages name parameters by class ("PrandtlIshlinskii.weights[1]: ..."); the user
+// knows them by key path ("sensor.hysteresis.weights[1]: ...").
+std::string renamed(const std::string& why, std::string_view class_prefix,
+                    const std::string& key_path) {
+  if (why.rfind(class_prefix, 0) == 0) return key_path + why.substr(class_prefix.size());
+  return key_path + ": " + why;
+}
+
+template <typename Params>
+void validate(const YamlMap& map, const Params& params, std::string_view class_prefix,
+              const std::string& key) {
+  std::string why;
+  if (!params.is_valid(&why)) {
+    throw io::YamlError(map.locate(renamed(why, class_prefix, map.path(key) + ".")));
+  }
+}
+
+HysteresisCreep::Params read_operator(YamlMap& side) {
+  HysteresisCreep::Params p;
+  YamlMap h = side.map("hysteresis");
+  p.hysteresis.linear_weight = h.required<double>("linear_weight");
+  h.read_sequence("thresholds", p.hysteresis.thresholds);
+  h.read_sequence("weights", p.hysteresis.weights);
+  h.finish();
+  validate(side, p.hysteresis, "PrandtlIshlinskii.", "hysteresis");
+  if (auto s = side.optional_map("superposition")) {
+    s->read("linear_weight", p.superposition.linear_weight);
+    s->read_sequence("upper_thresholds", p.superposition.upper_thresholds);
+    s->read_sequence("upper_weights", p.superposition.upper_weights);
+    s->read_sequence("lower_thresholds", p.superposition.lower_thresholds);
+    s->read_sequence("lower_weights", p.superposition.lower_weights);
+    s->finish();
+    validate(side, p.superposition, "DeadZoneSuperposition.", "superposition");
+  }
+  if (auto c = side.optional_map("creep")) {
+    c->read_sequence("thresholds", p.creep.thresholds);
+    c->read_sequence("eigenvalues", p.creep.eigenvalues);
+    c->read_sequence("weights", p.creep.weights);
+    c->finish();
+    validate(side, p.creep, "ThresholdCreep.", "creep");
+  }
+  return p;
+}
+
+std::optional<SideModel> read_side(YamlMap& root, std::string_view key, double ts) {
+  std::optional<YamlMap> side = root.optional_map(key);
+  if (!side) return std::nullopt;
+  SideModel m;
+  m.sample_time = ts;
+  m.linear_gains = {side->optional<double>("coupling", 0.0)};
+  side->read("offset", m.offset);
+  side->read_sequence("history", m.history);
+  m.op = read_operator(*side);
+  side->finish();
+  return m;
+}
+
+TransducerModel read_model(YamlMap root) {
+  const int version = root.required<int>("selfsense_model");
+  if (version != kModelFormatVersion) {
+    root.fail("selfsense_model", "format version " + std::to_string(version) +
+                                     " is not supported (this build reads " +
+                                     std::to_string(kModelFormatVersion) + ")");
+  }
+  TransducerModel model;
+  const auto name = root.required<std::string>("structure");
+  const std::optional<Structure> structure = parse_structure(name);
+  if (!structure) root.fail("structure", "'" + name + "' is not one of " + structure_names());
+  model.structure = *structure;
+  model.sample_time = root.required<double>("sample_time_s");
+  if (!(model.sample_time > 0.0)) root.fail("sample_time_s", "must be > 0");
+  if (auto g = root.optional_map("geometry")) {
+    Geometry geo;
+    geo.layer_thickness = g->required<double>("layer_thickness_m");
+    geo.electrode_area = g->required<double>("electrode_area_m2");
+    geo.layers = g->required<double>("layers");
+    geo.active_length = g->required<double>("active_length_m");
+    geo.cross_section = g->required<double>("cross_section_m2");
+    g->finish();
+    std::string why;
+    if (!geo.is_valid(&why)) throw io::YamlError(root.locate(why));
+    model.geometry = geo;
+  }
+  model.sensor = read_side(root, "sensor", model.sample_time);
+  model.actuator = read_side(root, "actuator", model.sample_time);
+  if (root.has("fit")) static_cast<void>(root.optional_map("fit"));  // notes only
+  root.finish();
+  std::string why;
+  if (!model.is_valid(&why)) throw io::YamlError(root.locate(why));
+  return model;
+}
+
+void emit_sequence(YAML::Emitter& out, const char* key, const std::vector<double>& values) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+  for (const double v : values)
+    out << v;
+  out << YAML::EndSeq;
+}
+
+void emit_side(YAML::Emitter& out, const char* key, const SideModel& side) {
+  out << YAML::Key << key << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "coupling" << YAML::Value
+      << (side.linear_gains.empty() ? 0.0 : side.linear_gains.front());
+  out << YAML::Key << "offset" << YAML::Value << side.offset;
+  emit_sequence(out, "history", side.history);
+  const auto& h = side.op.hysteresis;
+  out << YAML::Key << "hysteresis" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "linear_weight" << YAML::Value << h.linear_weight;
+  emit_sequence(out, "thresholds", h.thresholds);
+  emit_sequence(out, "weights", h.weights);
+  out << YAML::EndMap;
+  const auto& s = side.op.superposition;
+  out << YAML::Key << "superposition" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "linear_weight" << YAML::Value << s.linear_weight;
+  emit_sequence(out, "upper_thresholds", s.upper_thresholds);
+  emit_sequence(out, "upper_weights", s.upper_weights);
+  emit_sequence(out, "lower_thresholds", s.lower_thresholds);
+  emit_sequence(out, "lower_weights", s.lower_weights);
+  out << YAML::EndMap;
+  const auto& c = side.op.creep;
+  out << YAML::Key << "creep" << YAML::Value << YAML::BeginMap;
+  emit_sequence(out, "thresholds", c.thresholds);
+  emit_sequence(out, "eigenvalues", c.eigenvalues);
+  emit_sequence(out, "weights", c.weights);
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+}
+
+}  // namespace
+
+TransducerModel load_model(const std::filesystem::path& path) {
+  return read_model(YamlMap::load_file(path));
+}
+
+TransducerModel model_from_string(const std::string& text, const std::string& source) {
+  return read_model(YamlMap::from_string(text, source));
+}
+
+std::string model_to_string(const TransducerModel& model, const std::string& fit_notes) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "selfsense_model" << YAML::Value << kModelFormatVersion;
+  out << YAML::Key << "structure" << YAML::Value << std::string(to_string(model.structure));
+  out << YAML::Key << "sample_time_s" << YAML::Value << model.sample_time;
+  if (model.geometry) {
+    const Geometry& g = *model.geometry;
+    out << YAML::Key << "geometry" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "layer_thickness_m" << YAML::Value << g.layer_thickness;
+    out << YAML::Key << "electrode_area_m2" << YAML::Value << g.electrode_area;
+    out << YAML::Key << "layers" << YAML::Value << g.layers;
+    out << YAML::Key << "active_length_m" << YAML::Value << g.active_length;
+    out << YAML::Key << "cross_section_m2" << YAML::Value << g.cross_section;
+    out << YAML::EndMap;
+  }
+  if (model.sensor) emit_side(out, "sensor", *model.sensor);
+  if (model.actuator) emit_side(out, "actuator", *model.actuator);
+  if (!fit_notes.empty()) out << YAML::Key << "fit" << YAML::Value << YAML::Load(fit_notes);
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+void save_model(const TransducerModel& model, const std::filesystem::path& path,
+                const std::string& fit_notes) {
+  const std::string text = model_to_string(model, fit_notes);
+  std::ofstream file(path);
+  if (!file || !(file << text) || !file.flush()) {
+    throw std::runtime_error(path.string() + ": cannot write the model");
+  }
+}
+
+}  // namespace selfsense::models

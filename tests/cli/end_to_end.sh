@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# End to end through the command line: plant -> identify -> simulate / reconstruct, and the
+# error paths a user meets first. Usage: end_to_end.sh SELFSENSE_BINARY SOURCE_DIR
+set -euo pipefail
+bin=$1
+src=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+cat >"$work/plant.yaml" <<'YAML'
+plant:
+  sample_rate_hz: 1000
+  hysteresis: {enabled: true}
+  creep: {enabled: true, tau_s: [0.05, 2.0], s_weights: [0.02, 0.02], d_weights: [0.01, 0.01]}
+  mechanics: {enabled: false, load_stiffness_n_per_m: 0.0, load_force_n: -300.0}
+excitation:
+  decaying: {amplitude_v_per_m: 0.9e6, offset_v_per_m: 1.0e6, frequency_hz: 1.0, decay_per_cycle: 0.9, cycles: 20}
+  load: {offset_n: 0.0, amplitude_n: 400.0, frequency_hz: 0.13}
+YAML
+"$bin" plant --config "$work/plant.yaml" --excitation decaying --out "$work/r.csv" >/dev/null
+"$bin" identify --recording "$work/r.csv" --structure hysteresis-creep --out "$work/m.yaml" \
+  --json "$work/m.json" --plays 12 --eigenvalues 3 >"$work/identify.txt"
+grep -q '"held_out"' "$work/m.json" || fail "identify JSON has no held_out figures"
+grep -q '^selfsense_model: 1' "$work/m.yaml" || fail "model file has no version"
+# The fitted model explains S well on the held-out part (nrmse below 2 %).
+held_s=$(sed -n 's/^  S  *[0-9.]* % *[0-9.]* % *\([0-9.]*\) %.*/\1/p' "$work/identify.txt")
+awk -v v="$held_s" 'BEGIN { exit !(v != "" && v < 2.0) }' || fail "held-out S nrmse '$held_s' %"
+
+"$bin" simulate --model "$work/m.yaml" --recording "$work/r.csv" --out "$work/sim.csv" >/dev/null
+head -n 20 "$work/sim.csv" | grep -q 'D_model' || fail "simulate wrote no D_model"
+head -n 20 "$work/sim.csv" | grep -q 'S_model' || fail "simulate wrote no S_model"
+"$bin" reconstruct --model "$work/m.yaml" --recording "$work/r.csv" --out "$work/rec.csv" >/dev/null
+head -n 20 "$work/rec.csv" | grep -q 'T_hat' || fail "reconstruct wrote no T_hat"
+
+# Bad input: a clear one-line error naming file, line and column, and a non-zero status.
+printf 't,E,D\n0,1,2\n0.001,abc,3\n' >"$work/bad.csv"
+if "$bin" reconstruct --model "$work/m.yaml" --recording "$work/bad.csv" --out "$work/x.csv" 2>"$work/err.txt"; then
+  fail "a non-numeric cell was accepted"
+fi
+grep -q "bad.csv:3: column 'E'" "$work/err.txt" || fail "error does not name line and column: $(cat "$work/err.txt")"
+[ ! -e "$work/x.csv" ] || fail "an output was written despite the error"
+if "$bin" identify --recording "$work/r.csv" --structure preisach --out "$work/y.yaml" 2>"$work/err.txt"; then
+  fail "an unknown structure was accepted"
+fi
+grep -q "not one of linear" "$work/err.txt" || fail "unknown structure message: $(cat "$work/err.txt")"
+sed 's/^structure: hysteresis-creep/structure: hysteresis-creep\nbogus: 1/' "$work/m.yaml" >"$work/bad.yaml"
+if "$bin" simulate --model "$work/bad.yaml" --recording "$work/r.csv" --out "$work/x.csv" 2>"$work/err.txt"; then
+  fail "an unknown model key was accepted"
+fi
+grep -q "bad.yaml:3: bogus" "$work/err.txt" || fail "model error: $(cat "$work/err.txt")"
+echo "end-to-end: 1 passed, 0 failed"

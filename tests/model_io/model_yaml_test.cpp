@@ -1,0 +1,79 @@
+#include "selfsense/models/model_yaml.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "selfsense/io/yaml_map.hpp"
+#include "support/transducer_data.hpp"
+
+namespace selfsense::models {
+namespace {
+
+void expect_error(const std::string& text, const std::string& fragment) {
+  try {
+    static_cast<void>(model_from_string(text, "M.yaml"));
+    FAIL() << "accepted; expected an error containing " << fragment;
+  } catch (const io::YamlError& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+  }
+}
+
+const std::string kMinimal = R"(selfsense_model: 1
+structure: hysteresis
+sample_time_s: 0.001
+sensor:
+  coupling: 3.0e-10
+  hysteresis:
+    linear_weight: 4.0e-8
+    thresholds: [1.0e5, 2.0e5]
+    weights: [1.0e-9, 2.0e-9]
+)";
+
+TEST(ModelYaml, RoundTripIsBitIdentical) {
+  TransducerModel m = test::typical_transducer(1e-4);
+  m.geometry = Geometry{60e-6, 25e-6, 167, 10e-3, 25e-6};
+  const std::string text = model_to_string(m, "S: {nrmse: 0.001}");
+  const TransducerModel back = model_from_string(text);
+  EXPECT_EQ(model_to_string(back, "S: {nrmse: 0.001}"), text);
+  EXPECT_EQ(back.sensor->op.hysteresis.weights, m.sensor->op.hysteresis.weights);
+  EXPECT_EQ(back.actuator->op.creep.weights, m.actuator->op.creep.weights);
+  EXPECT_EQ(back.sensor->history, m.sensor->history);
+  EXPECT_EQ(back.geometry->layers, 167.0);
+  EXPECT_EQ(back.structure, Structure::kHysteresisCreep);
+}
+
+TEST(ModelYaml, MinimalModelLoads) {
+  const TransducerModel m = model_from_string(kMinimal);
+  EXPECT_FALSE(m.actuator.has_value());
+  EXPECT_DOUBLE_EQ(m.sensor->linear_gains.at(0), 3e-10);
+  EXPECT_TRUE(m.sensor->op.creep.eigenvalues.empty());
+}
+
+TEST(ModelYaml, ErrorsNameFileLineAndKey) {
+  expect_error(kMinimal + "bogus: 1\n", "M.yaml:10: bogus");
+  std::string bad_weight = kMinimal;
+  bad_weight.replace(bad_weight.find("[1.0e-9, 2.0e-9]"), 16, "[-5.0e-8, 2.0e-9]");
+  expect_error(bad_weight, "sensor.hysteresis.weights[0]: partial sum");
+  std::string unsorted = kMinimal;
+  unsorted.replace(unsorted.find("[1.0e5, 2.0e5]"), 14, "[2.0e5, 1.0e5]");
+  expect_error(unsorted, "sensor.hysteresis.thresholds[1]");
+  std::string version = kMinimal;
+  version.replace(version.find("selfsense_model: 1"), 18, "selfsense_model: 7");
+  expect_error(version, "M.yaml:1: selfsense_model: format version 7");
+  std::string structure = kMinimal;
+  structure.replace(structure.find("hysteresis\n"), 10, "preisach");
+  expect_error(structure, "structure: 'preisach' is not one of linear");
+  expect_error("selfsense_model: 1\nstructure: linear\nsample_time_s: 0.001\n",
+               "needs a sensor or an actuator side");
+  expect_error(R"(selfsense_model: 1
+structure: linear
+sample_time_s: 0.001
+sensor:
+  coupling: 1.0
+)",
+               "sensor.hysteresis: required key is missing");
+}
+
+}  // namespace
+}  // namespace selfsense::models
