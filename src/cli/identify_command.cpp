@@ -3,6 +3,7 @@
 // rest (contracts.md).
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -28,6 +29,7 @@ struct IdentifyOptions {
   std::filesystem::path out{};
   std::filesystem::path json{};
   std::filesystem::path geometry{};
+  std::filesystem::path validate{};
   double holdout{0.2};
   int plays{-1};
   int eigenvalues{-1};
@@ -129,6 +131,19 @@ void run_identify(const IdentifyOptions& opt) {
   models::save_model(model, opt.out,
                      "{fit: " + to_json(fit).dump() + ", held_out: " + to_json(held).dump() + "}");
   std::printf("wrote %s\n", opt.out.string().c_str());
+  if (!opt.validate.empty()) {
+    const io::Recording vrec = io::read_recording_csv(opt.validate, io::ReadOptions{{"t"}});
+    const FieldSignals vsig = field_signals(vrec, opt.validate.string(), geometry, drive);
+    if (std::abs(vsig.sample_time - signals.sample_time) > 0.01 * signals.sample_time) {
+      throw io::RecordingError(opt.validate.string() +
+                               ": sample time differs from the recording's");
+    }
+    const std::vector<ChannelFigures> val =
+        figures(model, vsig, run_model(model, vsig, true, true), 0, vsig.size());
+    std::printf("validation on %s (%zu samples):\n", vsig.source.c_str(), vsig.size());
+    print_table(val, {});
+    report["validation"] = to_json(val);
+  }
   if (!opt.json.empty()) {
     std::ofstream file(opt.json);
     if (!file || !(file << report.dump(2) << '\n')) {
@@ -151,6 +166,8 @@ void add_identify_command(CLI::App& app) {
   cmd->add_option("--out", opt->out, "Model to write (YAML)")->required();
   cmd->add_option("--json", opt->json, "Fit figures to write (JSON)");
   cmd->add_option("--geometry", opt->geometry, "Transducer geometry (YAML), for u, q, x, F columns")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--validate", opt->validate, "A second recording to report the fit on")
       ->check(CLI::ExistingFile);
   cmd->add_option("--holdout", opt->holdout, "Share of the recording held out at its end")
       ->check(CLI::Range(0.0, 0.9));

@@ -8,101 +8,54 @@
 #include <string>
 #include <utility>
 
+#include "regressors.hpp"
 #include "selfsense/identification/nnls.hpp"
-#include "selfsense/operators/kernels.hpp"
 #include "selfsense/operators/linear_creep.hpp"
 
 namespace selfsense::identification {
 namespace {
 
+using detail::DeadZoneBasis;
+using detail::OperatorBasis;
+using detail::RegressorStream;
 using operators::DeadZoneSuperposition;
-using operators::HysteresisCreep;
 using RowBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 constexpr Eigen::Index kBlockRows = 512;
+constexpr double kShapeSlopeFloor = 1e-2;  // relative slope of a superposition on any interval
 
-// Columns of the regression and how each row is produced.
-struct Layout {
-  std::vector<double> thresholds{};  // r_0 = 0 first; creep thresholds are a subset
-  std::vector<std::size_t> creep_rows{};
-  std::vector<double> eigenvalues{};
-  std::vector<double> gains{};  // a_j = 1 - exp(-lambda_j Ts)
-  std::vector<double> upper{};  // S' dead-zone thresholds on the inner signal (stage 2)
+// Which coefficients are bounded below, and by what; built group by group in column order.
+struct Bounds {
+  std::vector<bool> bounded{};
   std::vector<double> lower{};
-  std::size_t linear_inputs{0};  // u_k columns (stage 1)
-  bool offset{false};            // constant column (stage 1)
 
-  [[nodiscard]] Eigen::Index plays() const { return static_cast<Eigen::Index>(thresholds.size()); }
-  [[nodiscard]] Eigen::Index creep() const {
-    return static_cast<Eigen::Index>(creep_rows.size() * eigenvalues.size());
+  void add(std::size_t count, bool is_bounded, double bound) {
+    bounded.insert(bounded.end(), count, is_bounded);
+    lower.insert(lower.end(), count, bound);
   }
-  [[nodiscard]] Eigen::Index dead_zones() const {
-    return static_cast<Eigen::Index>(upper.size() + lower.size());
-  }
-  [[nodiscard]] Eigen::Index cols() const {
-    return plays() + creep() + dead_zones() + static_cast<Eigen::Index>(linear_inputs) +
-           (offset ? 1 : 0);
-  }
+  [[nodiscard]] Eigen::Index size() const { return static_cast<Eigen::Index>(bounded.size()); }
 };
 
-// Streams the regression rows of samples [0, count) into a GramAccumulator.
-//   stage 1: target y,  columns q_i (W_i), z_rj (c_rj), u_k (g_k), 1 (offset)
-//   stage 2: target v - Zu_1(v) - Zl_1(v) with v = y - g u - offset,
-//            columns q_i, z_rj, -(Z_j(v) - Z_{j+1}(v)) (G_j)
-GramAccumulator accumulate(const Layout& layout, const OperatorSignals& s,
-                           std::span<const double> inner, std::span<const double> history,
-                           std::size_t count) {
-  const Eigen::Index cols = layout.cols();
+BoundedLeastSquaresSolution solve(const GramAccumulator& acc, const Bounds& bounds) {
+  return solve_bounded_least_squares(
+      {acc.gram(), acc.moment(), acc.output_energy(), bounds.bounded,
+       Eigen::Map<const Eigen::VectorXd>(bounds.lower.data(), bounds.size())});
+}
+
+// Streams rows over samples [0, count): fill(k, phi, row, target) writes one row, given the
+// operator columns phi of sample k.
+template <typename Fill>
+GramAccumulator accumulate(const OperatorBasis& basis, std::span<const double> x,
+                           std::span<const double> history, std::size_t count, Eigen::Index cols,
+                           Fill fill) {
   GramAccumulator acc(cols);
-  std::vector<double> plays(layout.thresholds.size(), history.front());
-  for (const double h : history)
-    operators::kernels::play_bank_step(h, layout.thresholds, plays);
-  const std::size_t n_eig = layout.eigenvalues.size();
-  std::vector<double> lags(layout.creep_rows.size() * n_eig);
-  for (std::size_t i = 0; i < layout.creep_rows.size(); ++i) {
-    std::fill_n(lags.begin() + static_cast<std::ptrdiff_t>(i * n_eig), n_eig,
-                plays[layout.creep_rows[i]]);
-  }
+  RegressorStream stream(basis, history);
   RowBlock block(kBlockRows, cols);
   Eigen::VectorXd target(kBlockRows);
   Eigen::Index row = 0;
-  const bool stage2 = layout.dead_zones() > 0;
   for (std::size_t k = 0; k < count; ++k) {
-    operators::kernels::play_bank_step(s.input[k], layout.thresholds, plays);
-    Eigen::Index c = 0;
-    for (std::size_t i = 0; i < plays.size(); ++i) {
-      block(row, c++) = plays[i] - (i + 1 < plays.size() ? plays[i + 1] : 0.0);
-    }
-    for (std::size_t i = 0; i < layout.creep_rows.size(); ++i) {
-      const double p = plays[layout.creep_rows[i]];
-      for (std::size_t j = 0; j < n_eig; ++j) {
-        double& z = lags[i * n_eig + j];
-        z += layout.gains[j] * (p - z);
-        block(row, c++) = z;
-      }
-    }
-    if (stage2) {
-      const double v = inner[k];
-      double y = v;
-      const auto side = [&](const std::vector<double>& d, bool up) {
-        for (std::size_t j = 0; j < d.size(); ++j) {
-          const double zj = up ? std::max(v - d[j], 0.0) : std::min(v - d[j], 0.0);
-          const double zn = j + 1 < d.size()
-                                ? (up ? std::max(v - d[j + 1], 0.0) : std::min(v - d[j + 1], 0.0))
-                                : 0.0;
-          if (j == 0) y -= zj;
-          block(row, c++) = -(zj - zn);
-        }
-      };
-      side(layout.upper, true);
-      side(layout.lower, false);
-      target(row) = y;
-    } else {
-      for (std::size_t u = 0; u < layout.linear_inputs; ++u)
-        block(row, c++) = s.linear_inputs[u][k];
-      if (layout.offset) block(row, c++) = 1.0;
-      target(row) = s.output[k];
-    }
+    fill(k, stream.next(x[k]),
+         std::span<double>(block.row(row).data(), static_cast<std::size_t>(cols)), target(row));
     if (++row == kBlockRows) {
       acc.add(block, target);
       row = 0;
@@ -112,47 +65,201 @@ GramAccumulator accumulate(const Layout& layout, const OperatorSignals& s,
   return acc;
 }
 
-struct Bounds {
-  std::vector<bool> bounded{};
-  Eigen::VectorXd lower{};
+// The fit in progress: y = S[theta . phi] + sum_k g_k u_k + offset.
+struct Fit {
+  Eigen::VectorXd theta{};  // W_i, then c_rj
+  DeadZoneSuperposition::Params shape{};
+  std::vector<double> gains{};
+  double offset{0.0};
+  double rss{std::numeric_limits<double>::infinity()};  // output error on the fitted samples
 };
 
-Bounds bounds_for(const Layout& layout, double weight_floor) {
-  const Eigen::Index n = layout.cols();
-  Bounds b{std::vector<bool>(static_cast<std::size_t>(n), false), Eigen::VectorXd::Zero(n)};
-  Eigen::Index c = 0;
-  for (Eigen::Index i = 0; i < layout.plays(); ++i, ++c) {
-    b.bounded[static_cast<std::size_t>(c)] = true;
-    b.lower(c) = weight_floor;
-  }
-  for (Eigen::Index i = 0; i < layout.creep(); ++i, ++c)
-    b.bounded[static_cast<std::size_t>(c)] = true;
-  for (Eigen::Index i = 0; i < layout.dead_zones(); ++i, ++c) {
-    b.bounded[static_cast<std::size_t>(c)] = true;
-    b.lower(c) = 1e-2;  // slope of S' at least 1 % of its initial slope
-  }
-  return b;
-}
+class Fitter {
+ public:
+  Fitter(const OperatorSignals& s, const OperatorBasis& basis, double weight_floor, bool offset)
+      : s_(s), basis_(basis), floor_(weight_floor), offset_(offset) {}
 
-BoundedLeastSquaresSolution solve(const Layout& layout, const GramAccumulator& acc,
-                                  double weight_floor) {
-  const Bounds b = bounds_for(layout, weight_floor);
-  return solve_bounded_least_squares(
-      {acc.gram(), acc.moment(), acc.output_energy(), b.bounded, b.lower});
-}
+  [[nodiscard]] std::size_t extras() const { return s_.linear_inputs.size() + (offset_ ? 1 : 0); }
 
-// Dead-zone thresholds on the inner signal, spread over its positive and negative range.
-void place_dead_zones(Layout& layout, std::span<const double> inner, std::size_t per_side) {
-  const auto [lo, hi] = std::minmax_element(inner.begin(), inner.end());
-  const double span = *hi - *lo;
-  for (std::size_t j = 1; j <= per_side; ++j) {
-    const double f = static_cast<double>(j) / static_cast<double>(per_side + 1);
-    if (*hi > 0.05 * span) layout.upper.push_back(f * *hi);
-    if (*lo < -0.05 * span) layout.lower.push_back(f * *lo);
+  // Everything linear, S = identity. Returns the fit and its residual sum of squares.
+  [[nodiscard]] Fit linear(std::span<const double> history, std::size_t count) const {
+    const std::size_t ops = basis_.columns();
+    const auto cols = static_cast<Eigen::Index>(ops + extras());
+    const GramAccumulator acc = accumulate(basis_, s_.input, history, count, cols,
+                                           [&](std::size_t k, auto phi, auto row, double& y) {
+                                             std::copy(phi.begin(), phi.end(), row.begin());
+                                             fill_extras(k, row.subspan(ops), 1.0);
+                                             y = s_.output[k];
+                                           });
+    const BoundedLeastSquaresSolution sol = solve(acc, operator_bounds(true));
+    Fit fit;
+    fit.theta = sol.theta.head(static_cast<Eigen::Index>(ops));
+    unpack_extras(sol.theta, ops, fit);
+    fit.rss = sol.residual_sum_of_squares;
+    return fit;
   }
-}
 
-// Samples until the input has come within 2 % of both its minimum and its maximum.
+  // Kuhnen's equation error: S'[y - g u - offset] = theta . phi with S' = S^-1 in the slope
+  // basis, its slope around 0 fixed at 1; g and offset kept from `from`.
+  [[nodiscard]] Fit equation_error(const Fit& from, std::span<const double> history,
+                                   std::size_t per_side) const {
+    const std::vector<double> inner = unloaded(from);
+    const DeadZoneBasis dz = detail::spread_dead_zones(inner, per_side);
+    const std::size_t ops = basis_.columns();
+    const std::size_t shape_cols = dz.columns() - 1;
+    std::vector<double> b(dz.columns());
+    const GramAccumulator acc = accumulate(basis_, s_.input, history, inner.size(),
+                                           static_cast<Eigen::Index>(ops + shape_cols),
+                                           [&](std::size_t k, auto phi, auto row, double& y) {
+                                             std::copy(phi.begin(), phi.end(), row.begin());
+                                             dz.evaluate(inner[k], b);
+                                             for (std::size_t j = 0; j < shape_cols; ++j)
+                                               row[ops + j] = -b[1 + j];
+                                             y = b[0];
+                                           });
+    Bounds bounds = operator_bounds(false);
+    bounds.add(shape_cols, true, kShapeSlopeFloor);
+    const BoundedLeastSquaresSolution sol = solve(acc, bounds);
+    std::vector<double> slopes{1.0};
+    for (std::size_t j = 0; j < shape_cols; ++j)
+      slopes.push_back(sol.theta(static_cast<Eigen::Index>(ops + j)));
+    Fit fit = from;
+    fit.theta = sol.theta.head(static_cast<Eigen::Index>(ops));
+    fit.shape = DeadZoneSuperposition(dz.superposition(slopes)).inverse().params();
+    fit.rss = output_rss(fit);
+    return fit;
+  }
+
+  // Output error for S, g and offset with theta fixed (linear in them given v = theta . phi).
+  [[nodiscard]] Fit refit_shape(const Fit& from, std::span<const double> history) const {
+    const std::vector<double> inner = unloaded_inner(from, history);
+    DeadZoneBasis dz{from.shape.upper_thresholds, from.shape.lower_thresholds};
+    const std::size_t shape_cols = dz.columns();
+    const auto cols = static_cast<Eigen::Index>(shape_cols + extras());
+    GramAccumulator acc(cols);
+    RowBlock block(kBlockRows, cols);
+    Eigen::VectorXd target(kBlockRows);
+    Eigen::Index row = 0;
+    for (std::size_t k = 0; k < inner.size(); ++k) {
+      const std::span<double> r(block.row(row).data(), static_cast<std::size_t>(cols));
+      dz.evaluate(inner[k], r.first(shape_cols));
+      fill_extras(k, r.subspan(shape_cols), 1.0);
+      target(row) = s_.output[k];
+      if (++row == kBlockRows) {
+        acc.add(block, target);
+        row = 0;
+      }
+    }
+    if (row > 0) acc.add(block.topRows(row), target.head(row));
+    Bounds bounds;
+    const double slope_scale = std::abs(from.shape.linear_weight);
+    bounds.add(shape_cols, true, kShapeSlopeFloor * slope_scale);
+    bounds.add(extras(), false, 0.0);
+    const BoundedLeastSquaresSolution sol = solve(acc, bounds);
+    Fit fit = from;
+    std::vector<double> slopes(sol.theta.data(), sol.theta.data() + shape_cols);
+    fit.shape = dz.superposition(slopes);
+    unpack_extras(sol.theta, shape_cols, fit);
+    fit.rss = output_rss(fit, history);
+    return fit;
+  }
+
+  // Gauss-Newton step for theta, g and offset with S fixed: S is piecewise linear, so around
+  // v0 = theta0 . phi, S(v) = S(v0) + S'(v0) (v - v0) exactly while v stays on its segment.
+  [[nodiscard]] Fit refit_operator(const Fit& from, std::span<const double> history) const {
+    const DeadZoneSuperposition shape(from.shape);
+    const std::vector<double> v0 = unloaded_inner(from, history);
+    const std::size_t ops = basis_.columns();
+    const auto cols = static_cast<Eigen::Index>(ops + extras());
+    const GramAccumulator acc =
+        accumulate(basis_, s_.input, history, v0.size(), cols,
+                   [&](std::size_t k, auto phi, auto row, double& y) {
+                     const double slope = shape.slope(v0[k]);
+                     for (std::size_t i = 0; i < ops; ++i)
+                       row[i] = slope * phi[i];
+                     fill_extras(k, row.subspan(ops), 1.0);
+                     y = s_.output[k] - (shape.evaluate(v0[k]) - slope * v0[k]);
+                   });
+    const BoundedLeastSquaresSolution sol = solve(acc, operator_bounds(true));
+    Fit fit = from;
+    fit.theta = sol.theta.head(static_cast<Eigen::Index>(ops));
+    unpack_extras(sol.theta, ops, fit);
+    fit.rss = output_rss(fit, history);
+    return fit;
+  }
+
+  void set_history(std::vector<double> history) { history_ = std::move(history); }
+
+ private:
+  // Bounds of the operator columns: W_i >= floor, c_rj >= 0, then (optionally) free extras.
+  [[nodiscard]] Bounds operator_bounds(bool with_extras) const {
+    Bounds b;
+    b.add(basis_.plays(), true, floor_);
+    b.add(basis_.creep(), true, 0.0);
+    if (with_extras) b.add(extras(), false, 0.0);
+    return b;
+  }
+
+  void fill_extras(std::size_t k, std::span<double> out, double one) const {
+    std::size_t c = 0;
+    for (const auto& u : s_.linear_inputs)
+      out[c++] = u[k];
+    if (offset_) out[c] = one;
+  }
+
+  void unpack_extras(const Eigen::VectorXd& theta, std::size_t first, Fit& fit) const {
+    auto c = static_cast<Eigen::Index>(first);
+    fit.gains.clear();
+    for (std::size_t u = 0; u < s_.linear_inputs.size(); ++u)
+      fit.gains.push_back(theta(c++));
+    fit.offset = offset_ ? theta(c) : 0.0;
+  }
+
+  // y - g u - offset.
+  [[nodiscard]] std::vector<double> unloaded(const Fit& fit) const {
+    std::vector<double> out(s_.output.begin(), s_.output.end());
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      out[k] -= fit.offset;
+      for (std::size_t u = 0; u < fit.gains.size(); ++u)
+        out[k] -= fit.gains[u] * s_.linear_inputs[u][k];
+    }
+    return out;
+  }
+
+  // v = theta . phi over the fitted samples.
+  [[nodiscard]] std::vector<double> unloaded_inner(const Fit& fit,
+                                                   std::span<const double> history) const {
+    RegressorStream stream(basis_, history);
+    std::vector<double> v(s_.output.size());
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      const std::span<const double> phi = stream.next(s_.input[k]);
+      v[k] = Eigen::Map<const Eigen::VectorXd>(phi.data(), static_cast<Eigen::Index>(phi.size()))
+                 .dot(fit.theta);
+    }
+    return v;
+  }
+
+  [[nodiscard]] double output_rss(const Fit& fit) const { return output_rss(fit, history_); }
+  [[nodiscard]] double output_rss(const Fit& fit, std::span<const double> history) const {
+    const DeadZoneSuperposition shape(fit.shape);
+    const std::vector<double> v = unloaded_inner(fit, history);
+    double rss = 0.0;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      double y = shape.evaluate(v[k]) + fit.offset;
+      for (std::size_t u = 0; u < fit.gains.size(); ++u)
+        y += fit.gains[u] * s_.linear_inputs[u][k];
+      rss += (s_.output[k] - y) * (s_.output[k] - y);
+    }
+    return rss;
+  }
+
+  const OperatorSignals& s_;
+  const OperatorBasis& basis_;
+  double floor_;
+  bool offset_;
+  std::vector<double> history_{};
+};
+
 std::size_t sweep_length(std::span<const double> x) {
   const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
   const double margin = 0.02 * (*hi - *lo);
@@ -235,58 +342,57 @@ void check_signals(const OperatorSignals& s) {
   if (!(*hi > *lo)) throw std::invalid_argument("fit_operator: the input is constant");
 }
 
+OperatorBasis basis_for(const OperatorSignals& signals, const OperatorStructure& structure,
+                        double x_range) {
+  const double ts = signals.sample_time;
+  OperatorBasis basis;
+  basis.thresholds.push_back(0.0);
+  for (std::size_t i = 1; i <= structure.plays; ++i) {
+    basis.thresholds.push_back(0.5 * x_range * static_cast<double>(i) /
+                               static_cast<double>(structure.plays + 1));
+  }
+  if (structure.eigenvalues > 0) {
+    const double duration = ts * static_cast<double>(signals.input.size());
+    const double fastest =
+        structure.fastest_eigenvalue > 0 ? structure.fastest_eigenvalue : std::min(100.0, 0.1 / ts);
+    const double slowest = structure.slowest_eigenvalue > 0
+                               ? structure.slowest_eigenvalue
+                               : std::min(3.0 / duration, 0.5 * fastest);
+    basis.eigenvalues = operators::log_spaced_eigenvalues(fastest, slowest, structure.eigenvalues);
+    for (const double l : basis.eigenvalues)
+      basis.gains.push_back(-std::expm1(-l * ts));
+    basis.creep_rows.push_back(0);
+    const std::size_t extra = std::min(structure.creep_plays, structure.plays);
+    for (std::size_t k = 1; k <= extra; ++k) {
+      basis.creep_rows.push_back(k * (structure.plays + 1) / (extra + 1));
+    }
+  }
+  return basis;
+}
+
 }  // namespace
 
 OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructure& structure) {
   check_signals(signals);
   const std::size_t n = signals.input.size();
-  const double ts = signals.sample_time;
   const auto [x_lo, x_hi] = std::minmax_element(signals.input.begin(), signals.input.end());
   const auto [y_lo, y_hi] = std::minmax_element(signals.output.begin(), signals.output.end());
   const double x_range = *x_hi - *x_lo;
   const double y_range = std::max(*y_hi - *y_lo, std::numeric_limits<double>::min());
   // W_i >= floor keeps the PI invertible with margin far below any useful weight.
   const double weight_floor = 1e-6 * y_range / x_range;
+  const OperatorBasis basis = basis_for(signals, structure, x_range);
+  Fitter fitter(signals, basis, weight_floor, structure.fit_offset);
 
-  Layout layout;
-  layout.thresholds.push_back(0.0);
-  for (std::size_t i = 1; i <= structure.plays; ++i) {
-    layout.thresholds.push_back(0.5 * x_range * static_cast<double>(i) /
-                                static_cast<double>(structure.plays + 1));
-  }
-  if (structure.eigenvalues > 0) {
-    const double duration = ts * static_cast<double>(n);
-    const double fastest =
-        structure.fastest_eigenvalue > 0 ? structure.fastest_eigenvalue : std::min(100.0, 0.1 / ts);
-    const double slowest = structure.slowest_eigenvalue > 0
-                               ? structure.slowest_eigenvalue
-                               : std::min(3.0 / duration, 0.5 * fastest);
-    layout.eigenvalues = operators::log_spaced_eigenvalues(fastest, slowest, structure.eigenvalues);
-    for (const double l : layout.eigenvalues)
-      layout.gains.push_back(-std::expm1(-l * ts));
-    layout.creep_rows.push_back(0);
-    const std::size_t extra = std::min(structure.creep_plays, structure.plays);
-    for (std::size_t k = 1; k <= extra; ++k) {
-      layout.creep_rows.push_back(k * (structure.plays + 1) / (extra + 1));
-    }
-  }
-  layout.linear_inputs = signals.linear_inputs.size();
-  layout.offset = structure.fit_offset;
-
-  // Remanent state: the candidate history that best explains the first part of the data, its
-  // last turning point then refined by golden-section search between the grid neighbours.
+  // Remanent state: the candidate history that best explains the first part of the data; the
+  // two best grid candidates are refined (rising and falling starts can be close).
   std::vector<double> history{signals.input.front()};
   if (structure.estimate_history && structure.plays > 0) {
     // The start state matters until the input has swept its whole range (wiping-out), so
     // twice that span decides between candidates.
     const std::size_t head =
         std::min(n, std::max<std::size_t>(2 * sweep_length(signals.input), 2000));
-    const auto residual = [&](const std::vector<double>& candidate) {
-      const GramAccumulator acc = accumulate(layout, signals, {}, candidate, head);
-      return solve(layout, acc, weight_floor).residual_sum_of_squares;
-    };
-    // Grid first, then refine the two best grid candidates (rising and falling starts can
-    // be close) and keep the best refined one.
+    const auto residual = [&](const std::vector<double>& h) { return fitter.linear(h, head).rss; };
     std::vector<std::pair<double, std::vector<double>>> ranked;
     for (std::vector<double>& candidate : history_candidates(signals.input)) {
       ranked.emplace_back(residual(candidate), std::move(candidate));
@@ -296,88 +402,71 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
     double best = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < std::min<std::size_t>(2, ranked.size()); ++i) {
       std::vector<double> candidate = ranked[i].second;
-      if (candidate.size() > 1)
-        candidate = refine_turning_point(candidate, x_range / 8.0, residual);
-      const double rss = std::min(residual(candidate), ranked[i].first);
+      double rss = ranked[i].first;
+      if (candidate.size() > 1) {
+        std::vector<double> refined = refine_turning_point(candidate, x_range / 8.0, residual);
+        const double refined_rss = residual(refined);
+        if (refined_rss < rss) {
+          rss = refined_rss;
+          candidate = std::move(refined);
+        }
+      }
       if (rss < best) {
         best = rss;
-        history = rss < ranked[i].first ? candidate : ranked[i].second;
+        history = std::move(candidate);
       }
     }
   }
+  fitter.set_history(history);
 
-  // Stage 1: everything linear with S = identity.
-  const BoundedLeastSquaresSolution first =
-      solve(layout, accumulate(layout, signals, {}, history, n), weight_floor);
-  Eigen::VectorXd theta = first.theta;
-  OperatorModel model;
-  model.sample_time = ts;
-  model.history = history;
-  const Eigen::Index lin0 = layout.plays() + layout.creep();
-  for (std::size_t u = 0; u < layout.linear_inputs; ++u) {
-    model.linear_gains.push_back(theta(lin0 + static_cast<Eigen::Index>(u)));
-  }
-  model.offset = layout.offset ? theta(layout.cols() - 1) : 0.0;
-
-  // Stage 2: inverse superposition on the equation error, g and offset kept.
-  DeadZoneSuperposition::Params shape_inverse;
+  // Linear stage, then (with dead zones) the equation error for S and output-error passes
+  // that refit S and the operator in turn, keeping whichever fit explains the data best.
+  Fit fit = fitter.linear(history, n);
   if (structure.dead_zones > 0) {
-    std::vector<double> inner(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      double v = signals.output[k] - model.offset;
-      for (std::size_t u = 0; u < layout.linear_inputs; ++u) {
-        v -= model.linear_gains[u] * signals.linear_inputs[u][k];
-      }
-      inner[k] = v;
+    Fit candidate = fitter.equation_error(fit, history, structure.dead_zones);
+    Fit best = candidate;
+    for (std::size_t pass = 0; pass < structure.refinement_passes; ++pass) {
+      candidate = fitter.refit_shape(candidate, history);
+      if (candidate.rss < best.rss) best = candidate;
+      candidate = fitter.refit_operator(candidate, history);
+      if (candidate.rss < best.rss) best = candidate;
     }
-    Layout shaped = layout;
-    shaped.linear_inputs = 0;
-    shaped.offset = false;
-    place_dead_zones(shaped, inner, structure.dead_zones);
-    if (shaped.dead_zones() > 0) {
-      theta = solve(shaped, accumulate(shaped, signals, inner, history, n), weight_floor).theta;
-      Eigen::Index c = shaped.plays() + shaped.creep();
-      const auto side = [&](const std::vector<double>& d, std::vector<double>& thresholds,
-                            std::vector<double>& weights) {
-        double previous = 1.0;
-        for (const double dj : d) {
-          thresholds.push_back(dj);
-          weights.push_back(theta(c) - previous);
-          previous = theta(c++);
-        }
-      };
-      side(shaped.upper, shape_inverse.upper_thresholds, shape_inverse.upper_weights);
-      side(shaped.lower, shape_inverse.lower_thresholds, shape_inverse.lower_weights);
-    }
+    fit = best;
   }
 
-  // Partial sums back to PI weights; creep weights as they are.
+  OperatorModel model;
+  model.sample_time = signals.sample_time;
+  model.history = history;
+  model.linear_gains = fit.gains;
+  model.offset = fit.offset;
+  model.op.superposition = fit.shape;
   auto& h = model.op.hysteresis;
-  h.linear_weight = theta(0);
-  for (Eigen::Index i = 1; i < layout.plays(); ++i) {
-    h.thresholds.push_back(layout.thresholds[static_cast<std::size_t>(i)]);
-    h.weights.push_back(theta(i) - theta(i - 1));
+  h.linear_weight = fit.theta(0);
+  for (std::size_t i = 1; i < basis.plays(); ++i) {
+    const auto c = static_cast<Eigen::Index>(i);
+    h.thresholds.push_back(basis.thresholds[i]);
+    h.weights.push_back(fit.theta(c) - fit.theta(c - 1));
   }
   auto& creep = model.op.creep;
-  creep.eigenvalues = layout.eigenvalues;
-  for (const std::size_t r : layout.creep_rows)
-    creep.thresholds.push_back(layout.thresholds[r]);
-  for (Eigen::Index c = 0; c < layout.creep(); ++c) {
-    creep.weights.push_back(std::max(0.0, theta(layout.plays() + c)));
+  creep.eigenvalues = basis.eigenvalues;
+  for (const std::size_t r : basis.creep_rows)
+    creep.thresholds.push_back(basis.thresholds[r]);
+  for (std::size_t c = 0; c < basis.creep(); ++c) {
+    creep.weights.push_back(std::max(0.0, fit.theta(static_cast<Eigen::Index>(basis.plays() + c))));
   }
-  model.op.superposition = DeadZoneSuperposition(shape_inverse).inverse().params();
   return model;
 }
 
 void simulate_operator(const OperatorModel& model, std::span<const double> x,
                        const std::vector<std::span<const double>>& linear_inputs,
                        std::span<double> y) {
-  HysteresisCreep op(model.op, model.sample_time);
+  operators::HysteresisCreep op(model.op, model.sample_time);
   op.set_history(model.history);
   for (std::size_t k = 0; k < x.size(); ++k) {
     double v = op.step(x[k]) + model.offset;
-    for (std::size_t u = 0; u < linear_inputs.size(); ++u)
+    for (std::size_t u = 0; u < linear_inputs.size(); ++u) {
       v += model.linear_gains[u] * linear_inputs[u][k];
+    }
     y[k] = v;
   }
 }

@@ -14,7 +14,10 @@
 //     least-squares problem on the normal equations (solve_bounded_least_squares);
 //  2. with dead zones, the inverse superposition S' = S^-1 is fitted in the same way on the
 //     equation error S'[y - g u - offset] = H[x] + K[x] (Kuhnen's modified-PI identification),
-//     with g and offset from step 1, and inverted in closed form;
+//     with g and offset from step 1, and inverted in closed form; then output-error passes
+//     alternate between S, g, offset (linear in them for a fixed H + K) and a Gauss-Newton
+//     step for H + K, g, offset (exact on each linear piece of S), each a bounded least-squares
+//     problem again; the fit with the smallest output error is kept;
 //  3. the remanent state before the first sample is chosen among candidate input histories
 //     (a previous extremum at a grid of levels) by the residual on the first part of the data.
 // Thresholds follow from the input's range, creep eigenvalues from the sample time and the
@@ -38,6 +41,7 @@ struct OperatorStructure {
   double slowest_eigenvalue{0.0};  // [1/s]; 0: 3 / duration
   bool estimate_history{true};     // false: start demagnetised at the first input
   bool fit_offset{true};
+  std::size_t refinement_passes{2};  // output-error passes after the equation error (dead zones)
 };
 
 struct OperatorSignals {
