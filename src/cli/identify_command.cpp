@@ -2,6 +2,7 @@
 // reference channels, on its first part, and reports the fit on that part and on the held-out
 // rest (contracts.md).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -31,6 +32,7 @@ struct IdentifyOptions {
   std::filesystem::path geometry{};
   std::filesystem::path validate{};
   double holdout{0.2};
+  double fit_until{0.0};  // > 0: fit on t < fit_until instead of a share
   int plays{-1};
   int eigenvalues{-1};
   int creep_plays{-1};
@@ -79,8 +81,13 @@ void run_identify(const IdentifyOptions& opt) {
       field_signals(rec, opt.recording.string(), geometry, models::drive_of(*structure));
   const models::Drive drive = models::drive_of(*structure);
   const std::size_t n = signals.size();
-  const auto split = static_cast<std::size_t>(static_cast<double>(n) * (1.0 - opt.holdout));
-  if (split < 2) throw std::invalid_argument("--holdout leaves fewer than 2 samples to fit");
+  auto split = static_cast<std::size_t>(static_cast<double>(n) * (1.0 - opt.holdout));
+  if (opt.fit_until > 0.0) {
+    split = static_cast<std::size_t>(
+        std::lower_bound(signals.t.begin(), signals.t.end(), opt.fit_until) - signals.t.begin());
+  }
+  if (split < 2)
+    throw std::invalid_argument("--holdout or --fit-until leave fewer than 2 samples to fit");
 
   models::IdentificationOptions sizes = models::defaults_for(*structure);
   if (opt.plays >= 0) sizes.plays = static_cast<std::size_t>(opt.plays);
@@ -171,6 +178,8 @@ void add_identify_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--holdout", opt->holdout, "Share of the recording held out at its end")
       ->check(CLI::Range(0.0, 0.9));
+  cmd->add_option("--fit-until", opt->fit_until, "Fit on t < this time [s]; the rest is held out")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--plays", opt->plays, "Play operators (default per structure)")
       ->check(CLI::Range(0, 512));
   cmd->add_option("--eigenvalues", opt->eigenvalues, "Creep eigenvalues")->check(CLI::Range(0, 32));
