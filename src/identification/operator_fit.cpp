@@ -8,16 +8,13 @@
 #include <string>
 #include <utility>
 
-#include "regressors.hpp"
 #include "selfsense/identification/nnls.hpp"
+#include "selfsense/identification/regressors.hpp"
 #include "selfsense/operators/linear_creep.hpp"
 
 namespace selfsense::identification {
 namespace {
 
-using detail::DeadZoneBasis;
-using detail::OperatorBasis;
-using detail::RegressorStream;
 using operators::DeadZoneSuperposition;
 using RowBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
@@ -104,7 +101,7 @@ class Fitter {
   [[nodiscard]] Fit equation_error(const Fit& from, std::span<const double> history,
                                    std::size_t per_side) const {
     const std::vector<double> inner = unloaded(from);
-    const DeadZoneBasis dz = detail::spread_dead_zones(inner, per_side);
+    const DeadZoneBasis dz = spread_dead_zones(inner, per_side);
     const std::size_t ops = basis_.columns();
     const std::size_t shape_cols = dz.columns() - 1;
     std::vector<double> b(dz.columns());

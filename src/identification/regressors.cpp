@@ -1,11 +1,11 @@
-#include "regressors.hpp"
+#include "selfsense/identification/regressors.hpp"
 
 #include <algorithm>
 #include <cassert>
 
 #include "selfsense/operators/kernels.hpp"
 
-namespace selfsense::identification::detail {
+namespace selfsense::identification {
 
 RegressorStream::RegressorStream(const OperatorBasis& basis, std::span<const double> history)
     : basis_(&basis),
@@ -91,4 +91,4 @@ DeadZoneBasis spread_dead_zones(std::span<const double> v, std::size_t per_side)
   return out;
 }
 
-}  // namespace selfsense::identification::detail
+}  // namespace selfsense::identification

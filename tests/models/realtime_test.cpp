@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "selfsense/models/reconstructor.hpp"
+#include "selfsense/models/stress_hysteresis.hpp"
 #include "support/allocation_counter.hpp"
 #include "support/transducer_data.hpp"
 
@@ -14,6 +15,7 @@ namespace {
 
 static_assert(noexcept(std::declval<Reconstructor&>().step(0.0, 0.0)));
 static_assert(noexcept(std::declval<ForwardModel&>().step(0.0, 0.0)));
+static_assert(noexcept(std::declval<StressHysteresisReconstructor&>().step(0.0, 0.0)));
 
 TEST(ModelRealTime, StepsAndStateSavesDoNotAllocate) {
   const TransducerModel model = test::typical_transducer(1e-4);
@@ -30,6 +32,18 @@ TEST(ModelRealTime, StepsAndStateSavesDoNotAllocate) {
     r.restore_state(state);
     sink += est.strain + out.sensed;
   }
+  EXPECT_EQ(counter.count(), 0U);
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+TEST(ModelRealTime, NumericalStressReconstructionDoesNotAllocate) {
+  const test::TransducerData d =
+      test::transducer_data(test::typical_transducer(1e-4), 3000, 1e-4, 6);
+  StressHysteresisReconstructor r(fit_stress_hysteresis(d.e, d.t, d.d, d.s, 1e-4, 12));
+  double sink = 0.0;
+  test::AllocationCounter counter;
+  for (std::size_t k = 0; k < d.e.size(); ++k)
+    sink += r.step(d.e[k], d.d[k]).stress;
   EXPECT_EQ(counter.count(), 0U);
   EXPECT_TRUE(std::isfinite(sink));
 }

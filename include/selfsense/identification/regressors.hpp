@@ -1,4 +1,4 @@
-// Regressor streams of the operator fit (internal to selfsense_identification).
+// Regressor streams: the batch form of the operators for identification, one row per sample.
 //
 // Operator columns, per sample: q_i = p_i - p_{i+1} (p_{n+1} = 0) for the PI partial sums W_i,
 // so that H[x] = sum_i W_i q_i, then the creep lags z_rj for c_rj. Dead-zone columns use the
@@ -14,7 +14,7 @@
 
 #include "selfsense/operators/dead_zone_superposition.hpp"
 
-namespace selfsense::identification::detail {
+namespace selfsense::identification {
 
 struct OperatorBasis {
   std::vector<double> thresholds{};  // r_0 = 0 first; creep thresholds are a subset
@@ -60,4 +60,4 @@ struct DeadZoneBasis {
 // left out when v hardly reaches it).
 [[nodiscard]] DeadZoneBasis spread_dead_zones(std::span<const double> v, std::size_t per_side);
 
-}  // namespace selfsense::identification::detail
+}  // namespace selfsense::identification

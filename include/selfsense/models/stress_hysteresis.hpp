@@ -1,0 +1,79 @@
+// Stress-dependent hysteresis: the vectorial case of section 3.3 that the paper leaves as
+// future work, in a form that stays linear in its parameters. With q(E) the play columns of the
+// field history (identification/regressors.hpp: H[E] = W . q),
+//   D = W0 . q + T (W1 . q) + d1 T + d2 T^2 + D0       sensor side
+//   S = A0 . q + T (A1 . q) + s1 T + s2 T^2 + S0       actuator side
+// so coupling, permittivity and hysteresis amplitude all change with stress. D is no longer
+// affine in T, so reconstruction solves D_model(E, T) = D_measured for T at every sample with
+// the bracketed solver, which checks that the D-T characteristic is monotone on the bracket
+// (existence and uniqueness of the inverse, eq. 3) and reports when it is not.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "selfsense/identification/regressors.hpp"
+#include "selfsense/models/bracketed_solver.hpp"
+
+namespace selfsense::models {
+
+struct StressHysteresisSide {
+  std::vector<double> base{};    // W0 on the play columns
+  std::vector<double> stress{};  // W1: change of the hysteresis per Pa
+  double linear{0.0};            // d1 (or s1)
+  double quadratic{0.0};         // d2 (or s2)
+  double offset{0.0};
+
+  // y at the play columns q and stress t. Real-time safe.
+  [[nodiscard]] double evaluate(std::span<const double> q, double t) const noexcept;
+};
+
+struct StressHysteresisModel {
+  double sample_time{0.0};
+  identification::OperatorBasis basis{};  // plays only (no creep)
+  std::vector<double> history{};          // field turning points before the first sample
+  std::optional<StressHysteresisSide> sensor{};
+  std::optional<StressHysteresisSide> actuator{};
+  double stress_min{0.0};  // reconstruction bracket [Pa]
+  double stress_max{0.0};
+};
+
+// Fits both sides by least squares (W0 partial sums bounded below so the field dependence stays
+// increasing, everything else free). The bracket is the recorded stress range widened by a tenth of
+// its span on each side. Throws std::invalid_argument on mismatched or empty signals.
+[[nodiscard]] StressHysteresisModel fit_stress_hysteresis(std::span<const double> e,
+                                                          std::span<const double> t,
+                                                          std::span<const double> d,
+                                                          std::span<const double> s,
+                                                          double sample_time, std::size_t plays);
+
+// Per-sample reconstruction; allocation-free after construction.
+class StressHysteresisReconstructor final {
+ public:
+  struct Estimate {
+    double stress{0.0};
+    double strain{0.0};  // NaN without an actuator side
+    SolveStatus status{SolveStatus::kOk};
+  };
+  // Throws std::invalid_argument without a sensor side. Keeps its own copy of the model.
+  explicit StressHysteresisReconstructor(StressHysteresisModel model, SolverOptions options = {});
+  StressHysteresisReconstructor(const StressHysteresisReconstructor&) = delete;
+  StressHysteresisReconstructor& operator=(const StressHysteresisReconstructor&) = delete;
+  StressHysteresisReconstructor(StressHysteresisReconstructor&&) = delete;
+  StressHysteresisReconstructor& operator=(StressHysteresisReconstructor&&) = delete;
+  ~StressHysteresisReconstructor() = default;
+  Estimate step(double e, double d) noexcept;
+  // How often each SolveStatus occurred, indexed by its value.
+  [[nodiscard]] const std::array<std::size_t, 4>& status_counts() const noexcept { return counts_; }
+
+ private:
+  StressHysteresisModel model_;  // the stream below points into it: not copyable
+  SolverOptions options_{};
+  identification::RegressorStream stream_;
+  std::array<std::size_t, 4> counts_{};
+};
+
+}  // namespace selfsense::models
