@@ -24,8 +24,8 @@ struct FieldSignals {
 
   [[nodiscard]] std::size_t size() const noexcept { return t.size(); }
   // The drive and sensed channel for a structure (E/D, or D/E for charge drive).
-  [[nodiscard]] std::span<const double> drive(models::Drive drive) const noexcept;
-  [[nodiscard]] std::span<const double> sensed(models::Drive drive) const noexcept;
+  [[nodiscard]] std::span<const double> drive(models::Drive which) const noexcept;
+  [[nodiscard]] std::span<const double> sensed(models::Drive which) const noexcept;
 };
 
 // Reads E (or u), D (or q), S (or x), T (or F) as present; a terminal column needs `geometry`.
