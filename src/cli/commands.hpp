@@ -13,5 +13,7 @@ void add_plant_command(CLI::App& app);
 void add_identify_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_reconstruct_command(CLI::App& app);
+void add_feedforward_command(CLI::App& app);
+void add_import_command(CLI::App& app);
 
 }  // namespace selfsense::cli

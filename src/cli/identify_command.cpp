@@ -133,8 +133,14 @@ void run_identify(const IdentifyOptions& opt) {
                            {"seconds", seconds},
                            {"fit", to_json(fit)},
                            {"held_out", to_json(held)}};
-  if (model.sensor) report["sensor_coupling"] = model.sensor->linear_gains.at(0);
-  if (model.actuator) report["actuator_coupling"] = model.actuator->linear_gains.at(0);
+  if (runs.solver_failures > 0) report["solver_failures"] = runs.solver_failures;
+  // Couplings exist only when the recording had a stress channel.
+  if (model.sensor && !model.sensor->linear_gains.empty()) {
+    report["sensor_coupling"] = model.sensor->linear_gains.front();
+  }
+  if (model.actuator && !model.actuator->linear_gains.empty()) {
+    report["actuator_coupling"] = model.actuator->linear_gains.front();
+  }
   models::save_model(model, opt.out,
                      "{fit: " + to_json(fit).dump() + ", held_out: " + to_json(held).dump() + "}");
   std::printf("wrote %s\n", opt.out.string().c_str());

@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   selfsense::cli::add_identify_command(app);
   selfsense::cli::add_simulate_command(app);
   selfsense::cli::add_reconstruct_command(app);
+  selfsense::cli::add_feedforward_command(app);
+  selfsense::cli::add_import_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,14 +1,59 @@
 #include "model_runs.hpp"
 
+#include <cstdio>
 #include <optional>
 #include <span>
 
 #include "selfsense/models/reconstructor.hpp"
+#include "selfsense/models/stress_hysteresis.hpp"
 
 namespace selfsense::cli {
 
+namespace {
+
+// The stress-dependent model: forward from E and T, numerical reconstruction from E and D.
+ModelRuns run_vectorial(const models::StressHysteresisModel& m, const FieldSignals& signals,
+                        bool forward, bool reconstruct) {
+  const std::size_t n = signals.size();
+  ModelRuns runs;
+  if (forward) {
+    models::StressHysteresisForward f(m);
+    if (m.sensor) runs.sensed.resize(n);
+    if (m.actuator) runs.strain.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double stress = signals.stress.empty() ? 0.0 : signals.stress[k];
+      const models::StressHysteresisForward::Output out = f.step(signals.e[k], stress);
+      if (m.sensor) runs.sensed[k] = out.sensed;
+      if (m.actuator) runs.strain[k] = out.strain;
+    }
+  }
+  if (reconstruct && m.sensor && !signals.d.empty()) {
+    models::StressHysteresisReconstructor r(m);
+    runs.stress_hat.resize(n);
+    if (m.actuator) runs.strain_hat.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const models::StressHysteresisReconstructor::Estimate est =
+          r.step(signals.e[k], signals.d[k]);
+      runs.stress_hat[k] = est.stress;
+      if (m.actuator) runs.strain_hat[k] = est.strain;
+    }
+    const auto& c = r.status_counts();
+    runs.solver_failures = n - c[static_cast<std::size_t>(models::SolveStatus::kOk)];
+    if (runs.solver_failures > 0) {
+      std::fprintf(stderr,
+                   "warning: stress not uniquely reconstructed at %zu of %zu samples (no solution "
+                   "%zu, D-T not monotone %zu, not converged %zu)\n",
+                   runs.solver_failures, n, c[1], c[2], c[3]);
+    }
+  }
+  return runs;
+}
+
+}  // namespace
+
 ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& signals, bool forward,
                     bool reconstruct) {
+  if (model.vectorial) return run_vectorial(*model.vectorial, signals, forward, reconstruct);
   const models::Drive drive = model.drive();
   const std::span<const double> x = signals.drive(drive);
   const std::span<const double> y = signals.sensed(drive);

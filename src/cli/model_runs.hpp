@@ -18,6 +18,7 @@ struct ModelRuns {
   std::vector<double> strain{};  // S_model
   std::vector<double> stress_hat{};
   std::vector<double> strain_hat{};
+  std::size_t solver_failures{0};  // numerical reconstruction: samples without a unique T
 };
 
 // Forward with the recorded stress (0 where the recording has none); reconstruction where the

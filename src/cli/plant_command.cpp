@@ -1,7 +1,7 @@
 // `selfsense plant`: runs the simulated stack (selfsense::plant) over a generated or recorded
 // excitation and writes a recording (contracts.md): measured t, E, D; the plant's true S and T
-// as reference columns; temp where the temperature varies; and terminal and diagnostic columns
-// (u, q, x, F, E_true, D_true, p, status).
+// as reference columns; temp where the temperature varies; the true terminal values (u, q, x, F:
+// E_true, D_true, S, T through the geometry) and diagnostic columns (q_amp, p, status).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -105,8 +105,10 @@ void run_plant(const PlantOptions& opt) {
   rec.comments.push_back(line.str());
   rec.comments.emplace_back(
       "columns: t s, E V/m (measured), D C/m^2 (measured), S - and T Pa (plant truth), "
-      "temp degC, u V, q C (charge amplifier), x m, F N (stack force), E_true, D_true, "
-      "p (Preisach state), status (StatusFlag bits; a NaN sample repeats the previous value)");
+      "temp degC, E_true V/m, D_true C/m^2, u V, q C, x m, F N (true terminal values: "
+      "u = E_true h, q = D_true n A_el, x = S L, F = T A_mech), q_amp C (charge amplifier "
+      "output before delay and ADC), p (Preisach state), status (StatusFlag bits; a NaN sample "
+      "repeats the previous value)");
 
   const std::size_t n = out.size();
   auto column = [&out, n](auto member) {
@@ -131,6 +133,7 @@ void run_plant(const PlantOptions& opt) {
   rec.set_column("F", column([](const Out& o) { return o.f_n; }));
   rec.set_column("E_true", column([](const Out& o) { return o.e_v_per_m; }));
   rec.set_column("D_true", column([](const Out& o) { return o.d_c_per_m2; }));
+  rec.set_column("q_amp", column([](const Out& o) { return o.q_amp_c; }));
   rec.set_column("p", column([](const Out& o) { return o.polarisation; }));
   rec.set_column("status", column([](const Out& o) { return static_cast<double>(o.status); }));
   if (std::any_of(out.begin(), out.end(), [](const Out& o) { return o.latency_s > 0.0; })) {

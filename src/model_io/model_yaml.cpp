@@ -73,6 +73,36 @@ std::optional<SideModel> read_side(YamlMap& root, std::string_view key, double t
   return m;
 }
 
+std::optional<StressHysteresisSide> read_vectorial_side(YamlMap& v, std::string_view key) {
+  std::optional<YamlMap> m = v.optional_map(key);
+  if (!m) return std::nullopt;
+  StressHysteresisSide side;
+  m->read_sequence("base", side.base);
+  m->read_sequence("stress", side.stress);
+  side.linear = m->required<double>("linear");
+  m->read("quadratic", side.quadratic);
+  m->read("offset", side.offset);
+  m->finish();
+  return side;
+}
+
+StressHysteresisModel read_vectorial(YamlMap& root, double ts) {
+  YamlMap v = root.map("vectorial");
+  StressHysteresisModel m;
+  m.sample_time = ts;
+  v.read_sequence("thresholds", m.basis.thresholds);
+  v.read_sequence("history", m.history);
+  std::vector<double> range;
+  v.read_sequence("stress_range", range);
+  if (range.size() != 2) v.fail("stress_range", "expected [min, max]");
+  m.stress_min = range[0];
+  m.stress_max = range[1];
+  m.sensor = read_vectorial_side(v, "sensor");
+  m.actuator = read_vectorial_side(v, "actuator");
+  v.finish();
+  return m;
+}
+
 TransducerModel read_model(YamlMap root) {
   const int version = root.required<int>("selfsense_model");
   if (version != kModelFormatVersion) {
@@ -99,8 +129,12 @@ TransducerModel read_model(YamlMap root) {
     if (!geo.is_valid(&why)) throw io::YamlError(root.locate(why));
     model.geometry = geo;
   }
-  model.sensor = read_side(root, "sensor", model.sample_time);
-  model.actuator = read_side(root, "actuator", model.sample_time);
+  if (model.structure == Structure::kStressHysteresis) {
+    model.vectorial = read_vectorial(root, model.sample_time);
+  } else {
+    model.sensor = read_side(root, "sensor", model.sample_time);
+    model.actuator = read_side(root, "actuator", model.sample_time);
+  }
   if (root.has("fit")) static_cast<void>(root.optional_map("fit"));  // notes only
   root.finish();
   std::string why;
@@ -144,6 +178,25 @@ void emit_side(YAML::Emitter& out, const char* key, const SideModel& side) {
   out << YAML::EndMap;
 }
 
+void emit_vectorial(YAML::Emitter& out, const StressHysteresisModel& m) {
+  out << YAML::Key << "vectorial" << YAML::Value << YAML::BeginMap;
+  emit_sequence(out, "thresholds", m.basis.thresholds);
+  emit_sequence(out, "history", m.history);
+  emit_sequence(out, "stress_range", {m.stress_min, m.stress_max});
+  for (const auto& [name, side] :
+       {std::pair{"sensor", &m.sensor}, std::pair{"actuator", &m.actuator}}) {
+    if (!*side) continue;
+    out << YAML::Key << name << YAML::Value << YAML::BeginMap;
+    emit_sequence(out, "base", (*side)->base);
+    emit_sequence(out, "stress", (*side)->stress);
+    out << YAML::Key << "linear" << YAML::Value << (*side)->linear;
+    out << YAML::Key << "quadratic" << YAML::Value << (*side)->quadratic;
+    out << YAML::Key << "offset" << YAML::Value << (*side)->offset;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+}
+
 }  // namespace
 
 TransducerModel load_model(const std::filesystem::path& path) {
@@ -171,6 +224,7 @@ std::string model_to_string(const TransducerModel& model, const std::string& fit
     out << YAML::Key << "cross_section_m2" << YAML::Value << g.cross_section;
     out << YAML::EndMap;
   }
+  if (model.vectorial) emit_vectorial(out, *model.vectorial);
   if (model.sensor) emit_side(out, "sensor", *model.sensor);
   if (model.actuator) emit_side(out, "actuator", *model.actuator);
   if (!fit_notes.empty()) out << YAML::Key << "fit" << YAML::Value << YAML::Load(fit_notes);

@@ -9,12 +9,13 @@
 namespace selfsense::models {
 namespace {
 
-constexpr std::array<std::pair<Structure, std::string_view>, 5> kNames{{
+constexpr std::array<std::pair<Structure, std::string_view>, 6> kNames{{
     {Structure::kLinear, "linear"},
     {Structure::kPermittivity, "permittivity"},
     {Structure::kChargeDrive, "charge-drive"},
     {Structure::kHysteresis, "hysteresis"},
     {Structure::kHysteresisCreep, "hysteresis-creep"},
+    {Structure::kStressHysteresis, "stress-hysteresis"},
 }};
 
 bool side_valid(const char* name, const std::optional<SideModel>& side, double ts,
@@ -78,6 +79,13 @@ Drive drive_of(Structure s) noexcept {
 
 bool TransducerModel::is_valid(std::string* why) const {
   if (!operators::check::positive("sample_time", sample_time, why)) return false;
+  if (structure == Structure::kStressHysteresis) {
+    if (!vectorial || (!vectorial->sensor && !vectorial->actuator)) {
+      if (why != nullptr) *why = "model: stress-hysteresis needs its vectorial section";
+      return false;
+    }
+    return vectorial->is_valid(why);
+  }
   if (!sensor && !actuator) {
     if (why != nullptr) *why = "model: needs a sensor or an actuator side";
     return false;
@@ -98,6 +106,8 @@ IdentificationOptions defaults_for(Structure s) noexcept {
       return {24, 0, 0, 8, true, 0.0, 0.0};
     case Structure::kHysteresisCreep:
       return {24, 6, 2, 8, true, 0.0, 0.0};
+    case Structure::kStressHysteresis:
+      return {16, 0, 0, 0, false, 0.0, 0.0};
   }
   return {};
 }
@@ -116,6 +126,14 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
   TransducerModel model;
   model.structure = structure;
   model.sample_time = signals.sample_time;
+  if (structure == Structure::kStressHysteresis) {
+    if (signals.stress.empty()) {
+      throw std::invalid_argument("identify: stress-hysteresis needs a stress channel (T or F)");
+    }
+    model.vectorial = fit_stress_hysteresis(signals.drive, signals.stress, signals.sensed,
+                                            signals.strain, signals.sample_time, options.plays);
+    return model;
+  }
   std::vector<std::span<const double>> linear;
   if (!signals.stress.empty()) linear.push_back(signals.stress);
 

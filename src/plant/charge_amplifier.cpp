@@ -22,11 +22,13 @@ void ChargeAmplifier::reset(double q) noexcept {
 double ChargeAmplifier::update(double q, Random& random) noexcept {
   q_m_ = g_ * q_m_ + gain_ * (q - q_last_);
   q_last_ = q;
+  const double out = q_m_ + q_off_;
+  // The offset for the next sample, so that q_off[0] = offset and q_off(t) = offset + drift t.
   if (config_.drift_enabled) {
     q_off_ += config_.drift_c_per_s * ts_ +
               config_.random_walk_c_per_sqrt_s * std::sqrt(ts_) * random.gaussian();
   }
-  return q_m_ + q_off_;
+  return out;
 }
 
 }  // namespace selfsense::plant

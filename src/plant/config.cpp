@@ -107,22 +107,6 @@ bool PlantConfig::is_valid(std::string* why) const {
   c.positive("permittivity.reference_field_v_per_m", pe.reference_field_v_per_m);
   c.finite("permittivity.linear_coefficient", pe.linear_coefficient);
   c.finite("permittivity.quadratic_coefficient", pe.quadratic_coefficient);
-  if (c.ok() && pe.enabled) {
-    // D = eps E (1 + k1 x + k2 x^2) must rise with E over the amplifier's range (x = E / E_ref).
-    const double lo =
-        amplifier.voltage_min_v / geometry.layer_thickness_m / pe.reference_field_v_per_m;
-    const double hi =
-        amplifier.voltage_max_v / geometry.layer_thickness_m / pe.reference_field_v_per_m;
-    bool monotone = true;
-    for (int i = 0; i <= 200; ++i) {
-      const double x = lo + (hi - lo) * i / 200.0;
-      monotone =
-          monotone &&
-          1.0 + 2.0 * pe.linear_coefficient * x + 3.0 * pe.quadratic_coefficient * x * x > 0.0;
-    }
-    c.require(monotone, "permittivity.quadratic_coefficient", pe.quadratic_coefficient,
-              "D(E) must rise with E over the amplifier's voltage range");
-  }
 
   c.finite("stress.d_coefficient_per_pa", stress.d_coefficient_per_pa);
   c.finite("stress.hysteresis_coefficient_per_pa", stress.hysteresis_coefficient_per_pa);
@@ -152,12 +136,32 @@ bool PlantConfig::is_valid(std::string* why) const {
   c.non_negative("charge_amplifier.random_walk_c_per_sqrt_s",
                  charge_amplifier.random_walk_c_per_sqrt_s);
 
-  c.finite("amplifier.voltage_min_v", amplifier.voltage_min_v);
-  c.require(
-      std::isfinite(amplifier.voltage_max_v) && amplifier.voltage_max_v > amplifier.voltage_min_v,
-      "amplifier.voltage_max_v", amplifier.voltage_max_v, "must be above voltage_min_v");
+  // The plant starts at 0 V and a fault discharges the stack towards 0 V.
+  c.require(std::isfinite(amplifier.voltage_min_v) && amplifier.voltage_min_v <= 0.0,
+            "amplifier.voltage_min_v", amplifier.voltage_min_v, "must be a finite number <= 0");
+  c.require(std::isfinite(amplifier.voltage_max_v) &&
+                amplifier.voltage_max_v > amplifier.voltage_min_v && amplifier.voltage_max_v >= 0.0,
+            "amplifier.voltage_max_v", amplifier.voltage_max_v,
+            "must be above voltage_min_v and >= 0");
   c.positive("amplifier.slew_rate_v_per_s", amplifier.slew_rate_v_per_s);
   c.positive("amplifier.current_limit_a", amplifier.current_limit_a);
+
+  if (c.ok() && pe.enabled) {
+    // D = eps E (1 + k1 x + k2 x^2) must rise with E over the amplifier's range (x = E / E_ref).
+    const double lo =
+        amplifier.voltage_min_v / geometry.layer_thickness_m / pe.reference_field_v_per_m;
+    const double hi =
+        amplifier.voltage_max_v / geometry.layer_thickness_m / pe.reference_field_v_per_m;
+    bool monotone = true;
+    for (int i = 0; i <= 200; ++i) {
+      const double x = lo + (hi - lo) * i / 200.0;
+      monotone =
+          monotone &&
+          1.0 + 2.0 * pe.linear_coefficient * x + 3.0 * pe.quadratic_coefficient * x * x > 0.0;
+    }
+    c.require(monotone, "permittivity.quadratic_coefficient", pe.quadratic_coefficient,
+              "D(E) must rise with E over the amplifier's voltage range");
+  }
 
   check_channel(c, "sensors.e", sensors.e);
   check_channel(c, "sensors.d", sensors.d);

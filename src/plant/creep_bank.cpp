@@ -20,10 +20,17 @@ void CreepBank::reset(double y) noexcept {
     z_[j] = y;
 }
 
+double CreepBank::peek(double y) const noexcept {
+  double creep = 0.0;
+  for (std::size_t j = 0; j < n_; ++j)
+    creep += w_[j] * ((z_[j] + a_[j] * (y - z_[j])) - y0_);
+  return creep;
+}
+
 double CreepBank::update(double y) noexcept {
   double creep = 0.0;
   for (std::size_t j = 0; j < n_; ++j) {
-    z_[j] += a_[j] * (y - z_[j]);
+    z_[j] = z_[j] + a_[j] * (y - z_[j]);
     creep += w_[j] * (z_[j] - y0_);
   }
   return creep;

@@ -74,21 +74,24 @@ bool ExcitationConfig::is_valid(std::string* why) const {
   }
   c.finite("sines.offset_v_per_m", sines.offset_v_per_m);
   c.require(sines.cycles >= 1, "sines.cycles", sines.cycles, "must be >= 1");
-  c.require(sines.ramp_s >= 0.0, "sines.ramp_s", sines.ramp_s, "must be >= 0");
+  c.require(std::isfinite(sines.ramp_s) && sines.ramp_s >= 0.0, "sines.ramp_s", sines.ramp_s,
+            "must be a finite number >= 0");
   c.finite("decaying.amplitude_v_per_m", decaying.amplitude_v_per_m);
   c.finite("decaying.offset_v_per_m", decaying.offset_v_per_m);
   c.positive("decaying.frequency_hz", decaying.frequency_hz);
   c.require(decaying.decay_per_cycle > 0.0 && decaying.decay_per_cycle <= 1.0,
             "decaying.decay_per_cycle", decaying.decay_per_cycle, "must be in (0, 1]");
   c.require(decaying.cycles >= 1, "decaying.cycles", decaying.cycles, "must be >= 1");
-  c.require(decaying.ramp_s >= 0.0, "decaying.ramp_s", decaying.ramp_s, "must be >= 0");
+  c.require(std::isfinite(decaying.ramp_s) && decaying.ramp_s >= 0.0, "decaying.ramp_s",
+            decaying.ramp_s, "must be a finite number >= 0");
   c.positive("noise.duration_s", noise.duration_s);
   c.positive("noise.cutoff_hz", noise.cutoff_hz);
   c.require(std::isfinite(noise.std_v_per_m) && noise.std_v_per_m >= 0.0, "noise.std_v_per_m",
             noise.std_v_per_m, "must be >= 0");
   c.finite("noise.offset_v_per_m", noise.offset_v_per_m);
-  c.require(noise.max_v_per_m > noise.min_v_per_m, "noise.max_v_per_m", noise.max_v_per_m,
-            "must be above noise.min_v_per_m");
+  c.finite("noise.min_v_per_m", noise.min_v_per_m);
+  c.require(std::isfinite(noise.max_v_per_m) && noise.max_v_per_m > noise.min_v_per_m,
+            "noise.max_v_per_m", noise.max_v_per_m, "must be above noise.min_v_per_m");
   c.finite("load.offset_n", load.offset_n);
   c.finite("load.amplitude_n", load.amplitude_n);
   c.positive("load.frequency_hz", load.frequency_hz);

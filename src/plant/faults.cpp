@@ -1,6 +1,9 @@
 #include "selfsense/plant/faults.hpp"
 
 #include <algorithm>
+#include <limits>
+
+#include "selfsense/plant/status.hpp"
 
 namespace selfsense::plant {
 
@@ -47,6 +50,29 @@ FaultEffects FaultTable::at(std::int64_t sample) const noexcept {
     }
   }
   return fx;
+}
+
+Measurement apply_faults(const FaultEffects& fx, Measurement fresh, const Measurement& last,
+                         const Measurement& out_of_range, std::uint32_t* flags) noexcept {
+  Measurement m = fresh;
+  if (fx.disconnect_e || fx.disconnect_d) *flags |= kSensorDisconnect;
+  if (fx.stuck_e) m.e_v_per_m = last.e_v_per_m;
+  if (fx.stuck_d) m.d_c_per_m2 = last.d_c_per_m2;
+  if (fx.stuck_e || fx.stuck_d) *flags |= kStuckAdc;
+  if (fx.out_of_range_e) m.e_v_per_m = out_of_range.e_v_per_m;
+  if (fx.out_of_range_d) m.d_c_per_m2 = out_of_range.d_c_per_m2;
+  if (fx.out_of_range_e || fx.out_of_range_d) *flags |= kOutOfRange;
+  constexpr double kNan{std::numeric_limits<double>::quiet_NaN()};
+  if (fx.nan_e) m.e_v_per_m = kNan;
+  if (fx.nan_d) m.d_c_per_m2 = kNan;
+  if (fx.nan_e || fx.nan_d) *flags |= kNanSample;
+  if (fx.missed_data_ready) {
+    m = last;
+    *flags |= kMissedDataReady;
+  }
+  if (fx.late_by_s > 0.0) *flags |= kLateSample;
+  if (fx.amplifier_fault) *flags |= kAmplifierFault;
+  return m;
 }
 
 }  // namespace selfsense::plant

@@ -46,9 +46,14 @@ Mechanics::Mechanics(double resonance_hz, double damping_ratio, double sample_ti
   g1_[1] = e(1, 3) / sample_time_s;
 }
 
+double Mechanics::peek(double x_eq) const noexcept {
+  const double slope = x_eq - x_eq_prev_;
+  return phi_[0][0] * x_ + phi_[0][1] * v_ + g0_[0] * x_eq_prev_ + g1_[0] * slope;
+}
+
 double Mechanics::update(double x_eq) noexcept {
   const double slope = x_eq - x_eq_prev_;
-  const double x = phi_[0][0] * x_ + phi_[0][1] * v_ + g0_[0] * x_eq_prev_ + g1_[0] * slope;
+  const double x = peek(x_eq);
   const double v = phi_[1][0] * x_ + phi_[1][1] * v_ + g0_[1] * x_eq_prev_ + g1_[1] * slope;
   x_eq_prev_ = x_eq;
   x_ = x;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -13,6 +12,80 @@ namespace {
 // A coefficient scale 1 + k * delta, kept positive so no effect can flip a sign.
 double scale(double k, double delta) noexcept {
   return std::max(1.0 + k * delta, 0.05);
+}
+
+// Relative scales of the material coefficients at one temperature and stress.
+struct Scales {
+  double eps{1.0};
+  double d{1.0};
+  double hysteresis{1.0};
+  double compliance{1.0};
+};
+
+Scales temperature_scales(const TemperatureConfig& t, double temp_degc) noexcept {
+  if (!t.enabled) return Scales{};
+  const double dt = temp_degc - t.reference_degc;
+  return Scales{scale(t.permittivity_coefficient_per_k, dt), scale(t.d_coefficient_per_k, dt),
+                scale(t.hysteresis_coefficient_per_k, dt),
+                scale(t.compliance_coefficient_per_k, dt)};
+}
+
+Scales with_stress(Scales s, const StressConfig& st, double stress_pa) noexcept {
+  if (!st.enabled) return s;
+  s.eps *= scale(st.permittivity_coefficient_per_pa, stress_pa);
+  s.d *= scale(st.d_coefficient_per_pa, stress_pa);
+  s.hysteresis *= scale(st.hysteresis_coefficient_per_pa, stress_pa);
+  return s;
+}
+
+struct MechanicalInput {
+  Scales temperature{};
+  double e_v_per_m{0.0};
+  double dp{0.0};
+  double force_n{0.0};
+};
+
+struct MechanicalResponse {
+  Scales scales{};
+  double s_inst{0.0};
+  double x_eq_m{0.0};
+  double stress_pa{0.0};
+};
+
+// Steps 4-5 of Plant::step (plant.hpp) for a trial stress t_c, the argument of the
+// stress-dependent coefficients; the creep bank and the mechanics are only peeked at.
+MechanicalResponse respond(const PlantConfig& c, double length_m, const Plant::State& state,
+                           const MechanicalInput& in, double t_c) noexcept {
+  MechanicalResponse r{};
+  r.scales = with_stress(in.temperature, c.stress, t_c);
+  r.s_inst = c.material.d33_m_per_v * r.scales.d * in.e_v_per_m +
+             c.hysteresis.s_amplitude * r.scales.hysteresis * in.dp;
+  const double s_free = r.s_inst + state.creep_s.peek(r.s_inst);
+  const double compliance = c.material.compliance_m2_per_n * r.scales.compliance;
+  const double k_s = c.geometry.cross_section_m2 / (compliance * length_m);
+  r.x_eq_m = (k_s * length_m * s_free + in.force_n) / (k_s + c.mechanics.load_stiffness_n_per_m);
+  const double x = c.mechanics.enabled ? state.mechanics.peek(r.x_eq_m) : r.x_eq_m;
+  r.stress_pa = (x / length_m - s_free) / compliance;
+  return r;
+}
+
+// The self-consistent stress T = f(T) (only with the stress effect on; otherwise f is constant). f
+// is affine in T while no scale is clamped, so the secant through two trial points T_a (the last
+// stress) and T_b = T_a + kStressProbePa is exact:
+//   b = (f(T_b) - f(T_a)) / (T_b - T_a),   T = T_a + (f(T_a) - T_a) / (1 - b).
+// b is the loop gain of the stress feedback; where 1 - b < kMinContraction no unique solution
+// exists and f(T_a) (the stress with last sample's coefficients) is kept.
+constexpr double kStressProbePa{1.0e6};
+constexpr double kMinContraction{0.05};
+
+double solve_stress(const PlantConfig& c, double length_m, const Plant::State& state,
+                    const MechanicalInput& in) noexcept {
+  const double t_a = state.t_prev_pa;
+  const double f_a = respond(c, length_m, state, in, t_a).stress_pa;
+  const double f_b = respond(c, length_m, state, in, t_a + kStressProbePa).stress_pa;
+  const double b = (f_b - f_a) / kStressProbePa;
+  if (!(1.0 - b >= kMinContraction)) return f_a;
+  return t_a + (f_a - t_a) / (1.0 - b);
 }
 
 PlantConfig validated(const PlantConfig& config) {
@@ -75,8 +148,7 @@ void Plant::reset() {
   const double x0 = c.mechanics.load_force_n / (k_s + c.mechanics.load_stiffness_n_per_m);
   s.mechanics.reset(x0);
   s.t_prev_pa = x0 / derived_.length_m / c.material.compliance_m2_per_n;
-  const double d_scale = c.stress.enabled ? scale(c.stress.d_coefficient_per_pa, s.t_prev_pa) : 1.0;
-  s.d0 = c.material.d33_m_per_v * d_scale * s.t_prev_pa;
+  s.d0 = c.material.d33_m_per_v * with_stress(Scales{}, c.stress, s.t_prev_pa).d * s.t_prev_pa;
   s.capacitance_est_f = capacitance_linear(0.0);
   state_ = s;
 }
@@ -94,24 +166,6 @@ StepOutput Plant::step(const StepInput& input) noexcept {
   const FaultEffects fx = s.faults.at(s.sample);
   std::uint32_t flags = kStatusOk;
 
-  // Coefficient scales: temperature from the input, stress from the previous sample.
-  double eps_scale = 1.0;
-  double d_scale = 1.0;
-  double hyst_scale = 1.0;
-  double compliance_scale = 1.0;
-  if (c.temperature.enabled) {
-    const double dt = input.temp_degc - c.temperature.reference_degc;
-    eps_scale *= scale(c.temperature.permittivity_coefficient_per_k, dt);
-    d_scale *= scale(c.temperature.d_coefficient_per_k, dt);
-    hyst_scale *= scale(c.temperature.hysteresis_coefficient_per_k, dt);
-    compliance_scale *= scale(c.temperature.compliance_coefficient_per_k, dt);
-  }
-  if (c.stress.enabled) {
-    eps_scale *= scale(c.stress.permittivity_coefficient_per_pa, s.t_prev_pa);
-    d_scale *= scale(c.stress.d_coefficient_per_pa, s.t_prev_pa);
-    hyst_scale *= scale(c.stress.hysteresis_coefficient_per_pa, s.t_prev_pa);
-  }
-
   const double h = c.geometry.layer_thickness_m;
   const double u =
       s.amplifier.update(input.e_cmd_v_per_m * h, s.capacitance_est_f, fx.amplifier_fault, &flags);
@@ -120,31 +174,31 @@ StepOutput Plant::step(const StepInput& input) noexcept {
   double dp = 0.0;
   if (everett_) dp = s.preisach.update(*everett_, e) - s.p0;
 
-  const double d_eff = c.material.d33_m_per_v * d_scale;
-  double eps_eff = c.material.permittivity_f_per_m * eps_scale;
-  if (c.permittivity.enabled) {
-    const double x = e / c.permittivity.reference_field_v_per_m;
-    eps_eff *=
-        1.0 + c.permittivity.linear_coefficient * x + c.permittivity.quadratic_coefficient * x * x;
-  }
-  const double s_inst = d_eff * e + c.hysteresis.s_amplitude * hyst_scale * dp;
-  const double d_inst = eps_eff * e + c.hysteresis.d_amplitude_c_per_m2 * hyst_scale * dp;
-  const double s_free = s_inst + s.creep_s.update(s_inst);
-  const double d_free = d_inst + s.creep_d.update(d_inst);
-
-  const double compliance = c.material.compliance_m2_per_n * compliance_scale;
+  // Strain and stress at the self-consistent stress, then commit creep and mechanics.
   const double length = derived_.length_m;
-  const double k_s = c.geometry.cross_section_m2 / (compliance * length);
-  const double force = c.mechanics.load_force_n + input.force_n;
-  const double x_eq = (k_s * length * s_free + force) / (k_s + c.mechanics.load_stiffness_n_per_m);
-  const double x = c.mechanics.enabled ? s.mechanics.update(x_eq) : x_eq;
+  const MechanicalInput in{temperature_scales(c.temperature, input.temp_degc), e, dp,
+                           c.mechanics.load_force_n + input.force_n};
+  const double t_c = c.stress.enabled ? solve_stress(c, length, s, in) : 0.0;
+  const MechanicalResponse r = respond(c, length, s, in, t_c);
+  const double s_free = r.s_inst + s.creep_s.update(r.s_inst);
+  const double x = c.mechanics.enabled ? s.mechanics.update(r.x_eq_m) : r.x_eq_m;
   const double strain = x / length;
+  const double compliance = c.material.compliance_m2_per_n * r.scales.compliance;
   const double stress = (strain - s_free) / compliance;
-  const double d = d_free + d_eff * stress;
+
+  double eps_eff = c.material.permittivity_f_per_m * r.scales.eps;
+  if (c.permittivity.enabled) {
+    const double xe = e / c.permittivity.reference_field_v_per_m;
+    eps_eff *= 1.0 + c.permittivity.linear_coefficient * xe +
+               c.permittivity.quadratic_coefficient * xe * xe;
+  }
+  const double d_inst = eps_eff * e + c.hysteresis.d_amplitude_c_per_m2 * r.scales.hysteresis * dp;
+  const double d_free = d_inst + s.creep_d.update(d_inst);
+  const double d = d_free + c.material.d33_m_per_v * r.scales.d * stress;
 
   const double electrode_area = c.geometry.layers * c.geometry.electrode_area_m2;
   const double q = electrode_area * (d - s.d0);
-  const double q_m = s.charge_amplifier.update(q, s.random);
+  const double q_amp = s.charge_amplifier.update(q, s.random);
 
   const double du = u - s.u_prev_v;
   if (std::abs(du) > 1e-3) {
@@ -156,41 +210,28 @@ StepOutput Plant::step(const StepInput& input) noexcept {
   s.t_prev_pa = stress;
 
   // Every channel is sampled every time, so faults never shift the random sequence.
-  double e_meas = s.channel_e.measure(fx.disconnect_e ? 0.0 : e, s.random, &flags);
-  double d_meas =
-      s.channel_d.measure(fx.disconnect_d ? 0.0 : q_m / electrode_area, s.random, &flags);
-  if (fx.disconnect_e || fx.disconnect_d) flags |= kSensorDisconnect;
-  if (fx.stuck_e) e_meas = s.last.e_meas_v_per_m;
-  if (fx.stuck_d) d_meas = s.last.d_meas_c_per_m2;
-  if (fx.stuck_e || fx.stuck_d) flags |= kStuckAdc;
-  if (fx.out_of_range_e) e_meas = s.channel_e.out_of_range_value();
-  if (fx.out_of_range_d) d_meas = s.channel_d.out_of_range_value();
-  if (fx.out_of_range_e || fx.out_of_range_d) flags |= kOutOfRange;
-  if (fx.nan_e) e_meas = std::numeric_limits<double>::quiet_NaN();
-  if (fx.nan_d) d_meas = std::numeric_limits<double>::quiet_NaN();
-  if (fx.nan_e || fx.nan_d) flags |= kNanSample;
-  if (fx.missed_data_ready) {
-    e_meas = s.last.e_meas_v_per_m;
-    d_meas = s.last.d_meas_c_per_m2;
-    flags |= kMissedDataReady;
-  }
-  if (fx.late_by_s > 0.0) flags |= kLateSample;
-  if (fx.amplifier_fault) flags |= kAmplifierFault;
+  const Measurement fresh{
+      s.channel_e.measure(fx.disconnect_e ? 0.0 : e, s.random, &flags),
+      s.channel_d.measure(fx.disconnect_d ? 0.0 : q_amp / electrode_area, s.random, &flags)};
+  const Measurement measured = apply_faults(
+      fx, fresh, Measurement{s.last.e_meas_v_per_m, s.last.d_meas_c_per_m2},
+      Measurement{s.channel_e.out_of_range_value(), s.channel_d.out_of_range_value()}, &flags);
 
   StepOutput out{};
   out.t_s = static_cast<double>(s.sample) * ts_;
-  out.e_meas_v_per_m = e_meas;
-  out.d_meas_c_per_m2 = d_meas;
+  out.e_meas_v_per_m = measured.e_v_per_m;
+  out.d_meas_c_per_m2 = measured.d_c_per_m2;
   out.e_v_per_m = e;
   out.d_c_per_m2 = d - s.d0;
   out.s = strain;
   out.t_pa = stress;
   out.u_v = u;
-  out.q_c = q_m;
+  out.q_c = q;
   out.x_m = x;
   out.f_n = stress * c.geometry.cross_section_m2;
   out.temp_degc = input.temp_degc;
   out.polarisation = dp + s.p0;
+  out.q_amp_c = q_amp;
   out.latency_s = fx.late_by_s;
   out.status = flags;
   s.last = out;

@@ -33,6 +33,20 @@ head -n 20 "$work/sim.csv" | grep -q 'S_model' || fail "simulate wrote no S_mode
 "$bin" reconstruct --model "$work/m.yaml" --recording "$work/r.csv" --out "$work/rec.csv" >/dev/null
 head -n 20 "$work/rec.csv" | grep -q 'T_hat' || fail "reconstruct wrote no T_hat"
 
+# Without a T column: the free actuator (T = 0), actuator and sensor sides still fitted.
+cut -d, -f1-4 "$work/r.csv" | grep -v '^#' >"$work/free.csv"
+head -n 1 "$work/free.csv" | grep -q '^t,E,D,S$' || fail "unexpected plant columns: $(head -n 1 "$work/free.csv")"
+"$bin" identify --recording "$work/free.csv" --structure hysteresis --out "$work/free.yaml" \
+  --json "$work/free.json" >"$work/free.txt" || fail "identify without T failed"
+grep -q 'no T: free actuator' "$work/free.txt" || fail "identify did not say T is absent"
+
+# The stress-dependent (vectorial) model: identified, saved, loaded, reconstructed numerically.
+"$bin" identify --recording "$work/r.csv" --structure stress-hysteresis --out "$work/v.yaml" \
+  --plays 8 >/dev/null
+grep -q '^vectorial:' "$work/v.yaml" || fail "stress-hysteresis model has no vectorial section"
+"$bin" reconstruct --model "$work/v.yaml" --recording "$work/r.csv" --out "$work/vrec.csv" 2>/dev/null
+head -n 20 "$work/vrec.csv" | grep -q 'T_hat' || fail "vectorial reconstruct wrote no T_hat"
+
 # Bad input: a clear one-line error naming file, line and column, and a non-zero status.
 printf 't,E,D\n0,1,2\n0.001,abc,3\n' >"$work/bad.csv"
 if "$bin" reconstruct --model "$work/m.yaml" --recording "$work/bad.csv" --out "$work/x.csv" 2>"$work/err.txt"; then

@@ -43,6 +43,23 @@ TEST(ModelYaml, RoundTripIsBitIdentical) {
   EXPECT_EQ(back.structure, Structure::kHysteresisCreep);
 }
 
+TEST(ModelYaml, VectorialModelRoundTrips) {
+  const test::TransducerData d = test::transducer_data(test::typical_transducer(1e-3), 3000, 0, 4);
+  TransducerModel m;
+  m.structure = Structure::kStressHysteresis;
+  m.sample_time = 1e-3;
+  m.vectorial = fit_stress_hysteresis(d.e, d.t, d.d, d.s, 1e-3, 6);
+  const std::string text = model_to_string(m);
+  const TransducerModel back = model_from_string(text);
+  ASSERT_TRUE(back.vectorial.has_value());
+  EXPECT_EQ(back.vectorial->sensor->stress, m.vectorial->sensor->stress);
+  EXPECT_EQ(back.vectorial->basis.thresholds, m.vectorial->basis.thresholds);
+  EXPECT_EQ(model_to_string(back), text);
+  std::string broken = text;
+  broken.replace(broken.find("stress_range: ["), 15, "stress_range: [1, ");
+  expect_error(broken, "stress_range");
+}
+
 TEST(ModelYaml, MinimalModelLoads) {
   const TransducerModel m = model_from_string(kMinimal);
   EXPECT_FALSE(m.actuator.has_value());

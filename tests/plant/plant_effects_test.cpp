@@ -117,7 +117,10 @@ TEST(PlantEffects, ChargeOffsetDrifts) {
   c.charge_amplifier.random_walk_c_per_sqrt_s = 0.0;
   const auto out = run_field(c, std::vector<double>(10001, 0.0));
   const double area = 167 * 25e-6;
-  EXPECT_NEAR(out.back().d_meas_c_per_m2 * area, 1e-8 + 10.001 * 1e-8, 1e-13);
+  // q_off(t) = offset + drift t: the offset at t = 0, and t = 10 s at the last sample.
+  EXPECT_NEAR(out.front().q_amp_c, 1e-8, 1e-20);
+  EXPECT_NEAR(out.back().d_meas_c_per_m2 * area, 1e-8 + 10.0 * 1e-8, 1e-16);
+  EXPECT_DOUBLE_EQ(out.back().q_c, 0.0);  // the stack's charge does not drift
 }
 
 double ringing_frequency(const std::vector<StepOutput>& out, std::size_t from, double fs) {
@@ -280,12 +283,82 @@ TEST(PlantEffects, PermittivityDependsOnTheFieldOnlyWhenOn) {
 
 TEST(PlantEffects, TemperatureChangesTheCoefficientsOnlyWhenOn) {
   PlantConfig c{};
-  const auto strain = [](const PlantConfig& config, double temp) {
-    return run_field(config, {1.0e6}, 0.0, temp).back().s;
+  c.mechanics.load_stiffness_n_per_m = 5e7;  // a partly blocked stack: stress depends on s^E
+  const auto at = [](const PlantConfig& config, double temp) {
+    return run_field(config, {1.0e6}, 0.0, temp).back();
   };
-  EXPECT_DOUBLE_EQ(strain(c, 25.0), strain(c, 75.0));
+  EXPECT_DOUBLE_EQ(at(c, 25.0).s, at(c, 75.0).s);
+  EXPECT_DOUBLE_EQ(at(c, 25.0).d_c_per_m2, at(c, 75.0).d_c_per_m2);
   c.temperature.enabled = true;
-  EXPECT_NEAR(strain(c, 75.0) / strain(c, 25.0), 1.0 + 50.0 * 2e-3, 1e-9);
+  const StepOutput hot = at(c, 75.0);
+  // Quasi-static against the load spring: S = k_s / (k_s + k_l) d E, T = (S - d E) / s^E,
+  // D = eps E + d T, every coefficient scaled by 1 + k (75 - 25).
+  const double d = 5.5e-10 * (1.0 + 50.0 * 2e-3);
+  const double compliance = 3.5e-11 * (1.0 + 50.0 * 5e-4);
+  const double k_s = 25e-6 / (compliance * derive(c).length_m);
+  const double strain = k_s / (k_s + 5e7) * d * 1.0e6;
+  const double stress = (strain - d * 1.0e6) / compliance;
+  EXPECT_NEAR(hot.s / strain, 1.0, 1e-12);
+  EXPECT_NEAR(hot.t_pa / stress, 1.0, 1e-12);
+  EXPECT_NEAR(hot.d_c_per_m2 / (2.0e-8 * (1.0 + 50.0 * 4e-3) * 1.0e6 + d * stress), 1.0, 1e-12);
+}
+
+// The stress-dependent coefficients see the stress of the same sample: the recorded S, T and D
+// satisfy S = d(T) E + s^E T and D = eps(T) E + d(T) T at every sample, also at a force step.
+TEST(PlantEffects, StressFeedbackIsSelfConsistentAtEverySample) {
+  PlantConfig c{};
+  c.stress.enabled = true;
+  c.mechanics.load_stiffness_n_per_m = 2e7;
+  std::vector<StepInput> in(20, StepInput{2.0e6, 0.0, 25.0});
+  for (std::size_t k = 10; k < in.size(); ++k)
+    in[k].force_n = -800.0;
+  const auto out = simulate(c, in);
+  const StressConfig& st = c.stress;
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    SCOPED_TRACE(k);
+    const StepOutput& o = out[k];
+    const double d = 5.5e-10 * (1.0 + st.d_coefficient_per_pa * o.t_pa);
+    const double eps = 2.0e-8 * (1.0 + st.permittivity_coefficient_per_pa * o.t_pa);
+    EXPECT_NEAR(o.s, d * o.e_v_per_m + 3.5e-11 * o.t_pa, 1e-12 * std::abs(o.s) + 1e-18);
+    EXPECT_NEAR(o.d_c_per_m2, eps * o.e_v_per_m + d * o.t_pa, 1e-12 * std::abs(o.d_c_per_m2));
+  }
+  EXPECT_LT(out[10].t_pa, -1.0e7);  // the step did compress the stack
+}
+
+// Without dissipative effects the stack is conservative: stress-dependent coupling at a fast,
+// large cycle against a stiff load neither dissipates nor generates electrical energy.
+TEST(PlantEffects, StressCouplingGeneratesNoEnergy) {
+  PlantConfig c{};
+  c.stress.enabled = true;
+  c.mechanics.load_stiffness_n_per_m = 5e7;
+  const auto e = cosine_cycles(c.sample_rate_hz, 500.0, 3);
+  const auto out = run_field(c, e);
+  const std::size_t cycle = e.size() / 3;
+  EXPECT_NEAR(test::loop_energy(out, cycle, 2 * cycle), 0.0, 1e-6);  // J/m^3
+}
+
+// The terminal values are the field values through the geometry (physics.md).
+TEST(PlantEffects, TerminalValuesFollowTheGeometry) {
+  PlantConfig c{};
+  c.hysteresis.enabled = true;
+  c.creep.enabled = true;
+  c.mechanics.enabled = true;
+  c.mechanics.load_force_n = -300.0;
+  c.charge_amplifier.leakage_enabled = true;
+  c.charge_amplifier.drift_enabled = true;
+  c.charge_amplifier.offset_c = 1e-7;
+  const auto out = run_field(c, cosine_cycles(c.sample_rate_hz, 200.0, 1));
+  const double h = c.geometry.layer_thickness_m;
+  const double area = c.geometry.layers * c.geometry.electrode_area_m2;
+  const double length = derive(c).length_m;
+  for (const StepOutput& o : out) {
+    EXPECT_NEAR(o.u_v, o.e_v_per_m * h, 1e-12);
+    EXPECT_NEAR(o.q_c, o.d_c_per_m2 * area, 1e-18);
+    EXPECT_NEAR(o.x_m, o.s * length, 1e-18);
+    EXPECT_NEAR(o.f_n, o.t_pa * c.geometry.cross_section_m2, 1e-9);
+    EXPECT_NEAR(o.d_meas_c_per_m2, o.q_amp_c / area, 1e-15);  // ideal sensor on the amplifier
+  }
+  EXPECT_GT(std::abs(out.back().q_amp_c - out.back().q_c), 5e-8);  // leakage and offset
 }
 
 }  // namespace

@@ -63,10 +63,12 @@ double loop_height(const std::vector<StepOutput>& out, std::size_t from, std::si
   return down / n_down - up / n_up;
 }
 
-// Energy dissipated per unit volume over samples [from, to): the cyclic integral of E dD.
-inline double loop_energy(const std::vector<StepOutput>& out, std::size_t from, std::size_t to) {
+// Electrical energy taken in per unit volume (J/m^3) along samples first .. last: the trapezoidal
+// integral of E dD. Over a closed cycle (E[last] = E[first], E symmetric in time) a single-valued
+// D(E) gives 0 to rounding and a dissipative loop a positive area.
+inline double loop_energy(const std::vector<StepOutput>& out, std::size_t first, std::size_t last) {
   double w = 0.0;
-  for (std::size_t k = from; k + 1 < to; ++k) {
+  for (std::size_t k = first; k < last; ++k) {
     w += 0.5 * (out[k].e_v_per_m + out[k + 1].e_v_per_m) *
          (out[k + 1].d_c_per_m2 - out[k].d_c_per_m2);
   }

@@ -70,17 +70,27 @@ TEST(PreisachState, IsRateIndependent) {
   }
 }
 
-TEST(PreisachState, DeepNestingStaysBounded) {
+// More nested reversals than the memory holds: the oldest loops survive, the output stays on
+// the branches, and saturation wipes the whole memory.
+TEST(PreisachState, DeepNestingStaysBoundedAndSaturationWipesIt) {
   const EverettTable f{config()};
   PreisachState s{};
   s.reset(f, 0.0);
-  for (int i = 0; i < 1000; ++i) {
+  const double first_max = s.update(f, 2.0e6);
+  for (int i = 1; i < 1000; ++i) {
     const double amplitude = 1.0e6 * (1.0 - i / 1000.0);
     s.update(f, 1.0e6 + ((i % 2 == 0) ? amplitude : -amplitude));
   }
+  EXPECT_GE(s.turning_points(), PreisachState::kCapacity - 1);  // full (a merge frees two)
   EXPECT_LE(s.turning_points(), PreisachState::kCapacity);
-  EXPECT_GE(s.output(), -1.0);
-  EXPECT_LE(s.output(), 1.0);
+  EXPECT_GT(s.output(), -1.0);
+  EXPECT_LT(s.output(), 1.0);
+  // The dominant maximum is remembered: returning to it closes every inner loop.
+  EXPECT_NEAR(s.update(f, 2.0e6), first_max, 1e-12);
+  EXPECT_EQ(s.turning_points(), 2U);
+  EXPECT_DOUBLE_EQ(s.update(f, 3.0e6), 1.0);
+  EXPECT_DOUBLE_EQ(s.update(f, -1.0e6), -1.0);
+  EXPECT_EQ(s.turning_points(), 1U);
 }
 
 }  // namespace

@@ -14,6 +14,12 @@
 //                     lower_thresholds, lower_weights}
 //     creep: {thresholds, eigenvalues, weights}
 //   actuator: {...}                      # S = ..., same keys; coupling is the compliance
+//   vectorial:                           # structure stress-hysteresis instead of the sides:
+//     thresholds: [0, ...]               #   D = base.q + T stress.q + linear T
+//     history: [...]                     #       + quadratic T^2 + offset
+//     stress_range: [min, max]           #   (stress_hysteresis.hpp); bracket of the solver
+//     sensor: {base, stress, linear, quadratic, offset}
+//     actuator: {base, stress, linear, quadratic, offset}
 //   fit: {...}                           # free-form notes written by identify, not read back
 // Loading is strict: unknown keys, missing fields, wrong types and parameters that make an
 // operator non-invertible are errors naming file, line and key path.

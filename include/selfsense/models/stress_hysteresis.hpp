@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "selfsense/identification/regressors.hpp"
@@ -39,6 +40,10 @@ struct StressHysteresisModel {
   std::optional<StressHysteresisSide> actuator{};
   double stress_min{0.0};  // reconstruction bracket [Pa]
   double stress_max{0.0};
+
+  // Thresholds start at 0 and increase, every side has one weight per play, the bracket is
+  // ordered; names the field ("vectorial.sensor.base has 3 elements ...").
+  [[nodiscard]] bool is_valid(std::string* why) const;
 };
 
 // Fits both sides by least squares (W0 partial sums bounded below so the field dependence stays
@@ -49,6 +54,26 @@ struct StressHysteresisModel {
                                                           std::span<const double> d,
                                                           std::span<const double> s,
                                                           double sample_time, std::size_t plays);
+
+// Per-sample forward model (E, T -> D, S); allocation-free after construction.
+class StressHysteresisForward final {
+ public:
+  struct Output {
+    double sensed{0.0};  // D; NaN without a sensor side
+    double strain{0.0};  // S; NaN without an actuator side
+  };
+  explicit StressHysteresisForward(StressHysteresisModel model);
+  StressHysteresisForward(const StressHysteresisForward&) = delete;
+  StressHysteresisForward& operator=(const StressHysteresisForward&) = delete;
+  StressHysteresisForward(StressHysteresisForward&&) = delete;
+  StressHysteresisForward& operator=(StressHysteresisForward&&) = delete;
+  ~StressHysteresisForward() = default;
+  Output step(double e, double t) noexcept;
+
+ private:
+  StressHysteresisModel model_;  // the stream below points into it: not copyable
+  identification::RegressorStream stream_;
+};
 
 // Per-sample reconstruction; allocation-free after construction.
 class StressHysteresisReconstructor final {

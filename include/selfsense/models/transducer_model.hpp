@@ -13,6 +13,8 @@
 //   hysteresis        G = modified PI                          (eq. 14-15)
 //   hysteresis-creep  G = modified PI + creep                  (eq. 26-31)
 //   charge-drive      sensor E = modified PI of D, actuator S linear in D (eq. 18-19)
+//   stress-hysteresis coupling, permittivity and loop size depend on T (section 3.3, the
+//                     vectorial case): StressHysteresisModel, reconstructed numerically
 // Reconstruction (self-sensing) inverts the sensor side for T in closed form (eq. 7, 20, 30)
 // and feeds it to the actuator side (eq. 8, 21, 31): see Reconstructor.
 #pragma once
@@ -26,10 +28,18 @@
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/identification/operator_fit.hpp"
 #include "selfsense/models/geometry.hpp"
+#include "selfsense/models/stress_hysteresis.hpp"
 
 namespace selfsense::models {
 
-enum class Structure { kLinear, kPermittivity, kHysteresis, kHysteresisCreep, kChargeDrive };
+enum class Structure {
+  kLinear,
+  kPermittivity,
+  kHysteresis,
+  kHysteresisCreep,
+  kChargeDrive,
+  kStressHysteresis
+};
 enum class Drive { kField, kCharge };
 
 [[nodiscard]] std::string_view to_string(Structure s) noexcept;
@@ -48,7 +58,8 @@ struct TransducerModel {
   double sample_time{0.0};              // [s]
   std::optional<SideModel> sensor{};    // x -> D (field drive) or x -> E (charge drive)
   std::optional<SideModel> actuator{};  // x -> S
-  std::optional<Geometry> geometry{};   // for terminal quantities
+  std::optional<StressHysteresisModel> vectorial{};  // stress-hysteresis instead of the sides
+  std::optional<Geometry> geometry{};                // for terminal quantities
 
   [[nodiscard]] Drive drive() const noexcept { return drive_of(structure); }
   // The operator parameters and couplings are valid and the sample times agree.

@@ -2,7 +2,7 @@
 //   leakage: q_m[k] = g q_m[k-1] + (q[k] - q[k-1]) (1 - g) / (Ts / tau),  g = exp(-Ts / tau)
 //            (exact for a current constant over the sample); without leakage q_m = q - q(0).
 //   drift:   q_off[k] = q_off[k-1] + drift Ts + sigma sqrt(Ts) n[k],  q_off[0] = offset
-// Returns q_m + q_off. update() is real-time safe.
+// Returns q_m[k] + q_off[k]. update() is real-time safe.
 #pragma once
 
 #include "selfsense/plant/config.hpp"

@@ -74,8 +74,9 @@ struct PermittivityConfig {
 };
 
 // d(T) = d * (1 + d_coefficient * T), hysteresis amplitudes * (1 + hysteresis_coefficient * T),
-// eps(T) = eps * (1 + permittivity_coefficient * T); T in Pa (compression < 0). Large
-// compression therefore shrinks the coupling and the loops.
+// eps(T) = eps * (1 + permittivity_coefficient * T); T in Pa (compression < 0), the stack stress
+// of the same sample (Plant::step solves for it). Large compression therefore shrinks the
+// coupling and the loops. Every scale is kept >= 0.05 (also for temperature).
 struct StressConfig {
   bool enabled{false};
   double d_coefficient_per_pa{8e-9};
@@ -96,7 +97,8 @@ struct TemperatureConfig {
 // Stack and load as one mass-spring-damper:
 //   m x'' + c x' + (k_s + k_load) x = k_s L S_free + F_ext,   k_s = A_mech / (s^E L),
 // m = (k_s + k_load) / (2 pi resonance_hz)^2, c = 2 zeta sqrt((k_s + k_load) m).
-// Discretised exactly with zero-order hold on S_free and F_ext. Off: quasi-static (m = 0).
+// Discretised exactly with x_eq ramping linearly between samples (first-order hold,
+// mechanics.hpp). Off: quasi-static (m = 0).
 // Stress in the stack T = (x / L - S_free) / s^E.
 struct MechanicsConfig {
   bool enabled{false};
@@ -108,7 +110,8 @@ struct MechanicsConfig {
 
 // Charge amplifier with feedback resistance: the measured charge forgets with tau,
 //   q_m[k] = exp(-Ts/tau) q_m[k-1] + (q[k] - q[k-1]) * (1 - exp(-Ts/tau)) / (Ts/tau),
-// plus an offset q_off(t) = offset + drift * t + random walk (sigma * sqrt(Ts) per sample).
+// plus an offset q_off(t) = offset + drift * t + random walk (sigma * sqrt(Ts) per sample);
+// the offset terms act only with drift_enabled.
 struct ChargeAmplifierConfig {
   bool leakage_enabled{false};
   double leakage_tau_s{20.0};

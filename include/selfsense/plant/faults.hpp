@@ -34,6 +34,20 @@ struct FaultEffects {
   double late_by_s{0.0};
 };
 
+// One delivered sample of both channels.
+struct Measurement {
+  double e_v_per_m{0.0};
+  double d_c_per_m2{0.0};
+};
+
+// Applies the sample's faults to the freshly converted values: a stuck ADC or a missed
+// data-ready repeats the last delivered value, out_of_range and nan_sample replace it (in that
+// order of precedence, NaN last). ORs every fault's status bit into *flags. A disconnect acts on
+// the converter input (the caller measures 0) and only sets its bit here.
+[[nodiscard]] Measurement apply_faults(const FaultEffects& fx, Measurement fresh,
+                                       const Measurement& last, const Measurement& out_of_range,
+                                       std::uint32_t* flags) noexcept;
+
 class FaultTable final {
  public:
   // False when the table is full (kMaxScheduledFaults).

@@ -5,7 +5,7 @@
 //   [x; v][k] = Phi [x; v][k-1] + G0 x_eq[k-1] + G1 (x_eq[k] - x_eq[k-1])
 // Unconditionally stable at any sample rate. A zero-order hold would delay the drive by half a
 // sample and feed energy into the undamped resonator; the ramp keeps the D-E loop dissipative.
-// update() is real-time safe.
+// peek() and update() are real-time safe.
 #pragma once
 
 namespace selfsense::plant {
@@ -19,7 +19,9 @@ class Mechanics final {
     v_ = 0.0;
     x_eq_prev_ = x_eq;
   }
-  // Advances one sample with x_eq ramping from its previous value; returns the position x (m).
+  // The position x (m) one sample on, with x_eq ramping from its previous value; peek() leaves
+  // the state alone, update() advances it (both give the same x).
+  [[nodiscard]] double peek(double x_eq) const noexcept;
   double update(double x_eq) noexcept;
   [[nodiscard]] double position() const noexcept { return x_; }
   [[nodiscard]] double velocity() const noexcept { return v_; }

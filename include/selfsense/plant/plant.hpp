@@ -6,12 +6,15 @@
 //   1. amplifier:  u = Amp[E_cmd h]                         (range, slew, current limit)
 //   2. field:      E = u / h
 //   3. polarisation: p = Preisach[E]                         (hysteresis)
-//   4. free response with coefficients at temp and T[k-1]:
-//        S_i = d E + a_S (p - p0),  D_i = eps(E) E + a_D (p - p0)
-//        S_free = S_i + Creep_S[S_i],  D_free = D_i + Creep_D[D_i]
-//   5. mechanics:  x = MSD[x_eq],  S = x / L,  T = (S - S_free) / s^E
-//   6. charge:     D = D_free + d T,  q = n A_el (D - D(0)),  q_m = ChargeAmp[q]
-//   7. sensors:    E_meas = Ch_E[E],  D_meas = Ch_D[q_m / (n A_el)],  then faults
+//   4. free response, coefficients c(temp, T) at the input temperature and the stack stress T:
+//        S_i = d(T) E + a_S(T) (p - p0),  S_free = S_i + Creep_S[S_i]
+//   5. mechanics:  x = MSD[x_eq(S_free)],  S = x / L,  T = (S - S_free) / s^E
+//      Steps 4-5 make T a function f of the T that the coefficients see; the plant solves
+//      T = f(T) at every sample (f is affine in T, so two trial evaluations give the root), so
+//      S, T and D of one sample satisfy the constitutive law at one and the same stress.
+//   6. charge:     D_i = eps(E, T) E + a_D(T) (p - p0),  D = D_i + Creep_D[D_i] + d(T) T,
+//                  q = n A_el (D - D(0)),  q_amp = ChargeAmp[q]
+//   7. sensors:    E_meas = Ch_E[E],  D_meas = Ch_D[q_amp / (n A_el)],  then faults
 // Randomness comes from one std::mt19937_64 seeded with PlantConfig::seed.
 //
 // Real-time safety: step(), run(), inject(), clear_faults(), save() and restore() neither
@@ -48,17 +51,19 @@ struct StepOutput {
   // What a controller sees (delay, noise, ADC, leakage, drift, faults).
   double e_meas_v_per_m{0.0};
   double d_meas_c_per_m2{0.0};
-  // The truth, for reference columns.
+  // The truth, for reference columns. The terminal values follow from the field values by the
+  // geometry exactly: u = E h, q = D n A_el, x = S L, f = T A_mech.
   double e_v_per_m{0.0};
   double d_c_per_m2{0.0};  // relative to the charge at reset
   double s{0.0};
   double t_pa{0.0};
   double u_v{0.0};
-  double q_c{0.0};  // measured charge (charge amplifier output, before the ADC)
+  double q_c{0.0};  // stack charge, relative to the charge at reset
   double x_m{0.0};
   double f_n{0.0};  // force in the stack, T A_mech
   double temp_degc{0.0};
   double polarisation{0.0};  // Preisach output p
+  double q_amp_c{0.0};       // charge amplifier output (leakage, offset), before delay and ADC
   double latency_s{0.0};     // > 0 for a late sample
   std::uint32_t status{kStatusOk};
 };
