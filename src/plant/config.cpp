@@ -4,40 +4,13 @@
 #include <numbers>
 #include <sstream>
 
+#include "checker.hpp"
+
 namespace selfsense::plant {
 
 namespace {
 
-// Collects the first violated constraint, as "plant.<path>: <value>: <constraint>".
-class Checker final {
- public:
-  explicit Checker(std::string* why) : why_{why} {}
-  [[nodiscard]] bool ok() const { return ok_; }
-
-  template <typename T>
-  void require(bool condition, const std::string& path, T value, const std::string& constraint) {
-    if (!ok_ || condition) return;
-    ok_ = false;
-    if (why_ != nullptr) {
-      std::ostringstream out;
-      out << "plant." << path << ": " << value << ": " << constraint;
-      *why_ = out.str();
-    }
-  }
-  void positive(const std::string& path, double value) {
-    require(std::isfinite(value) && value > 0.0, path, value, "must be a finite number > 0");
-  }
-  void non_negative(const std::string& path, double value) {
-    require(std::isfinite(value) && value >= 0.0, path, value, "must be a finite number >= 0");
-  }
-  void finite(const std::string& path, double value) {
-    require(std::isfinite(value), path, value, "must be finite");
-  }
-
- private:
-  std::string* why_;
-  bool ok_{true};
-};
+using detail::Checker;
 
 std::string indexed(const std::string& path, std::size_t i) {
   return path + "[" + std::to_string(i) + "]";
@@ -57,7 +30,7 @@ void check_channel(Checker& c, const std::string& path, const ChannelConfig& ch)
 }  // namespace
 
 bool PlantConfig::is_valid(std::string* why) const {
-  Checker c{why};
+  Checker c{why, "plant."};
   c.positive("sample_rate_hz", sample_rate_hz);
   const double nyquist = 0.5 * sample_rate_hz;
 

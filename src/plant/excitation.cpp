@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "checker.hpp"
 #include "selfsense/plant/random.hpp"
 
 namespace selfsense::plant {
@@ -33,35 +34,12 @@ void sine(std::vector<double>& out, double offset, double amplitude, double freq
   }
 }
 
-class Checker final {
- public:
-  explicit Checker(std::string* why) : why_{why} {}
-  [[nodiscard]] bool ok() const { return ok_; }
-  void require(bool condition, const std::string& path, double value, const std::string& what) {
-    if (!ok_ || condition) return;
-    ok_ = false;
-    if (why_ != nullptr) {
-      std::ostringstream out;
-      out << "excitation." << path << ": " << value << ": " << what;
-      *why_ = out.str();
-    }
-  }
-  void positive(const std::string& path, double value) {
-    require(std::isfinite(value) && value > 0.0, path, value, "must be a finite number > 0");
-  }
-  void finite(const std::string& path, double value) {
-    require(std::isfinite(value), path, value, "must be finite");
-  }
-
- private:
-  std::string* why_;
-  bool ok_{true};
-};
+using detail::Checker;
 
 }  // namespace
 
 bool ExcitationConfig::is_valid(std::string* why) const {
-  Checker c{why};
+  Checker c{why, "excitation."};
   for (std::size_t i = 0; i < steps.levels_v_per_m.size(); ++i) {
     c.finite("steps.levels_v_per_m[" + std::to_string(i) + "]", steps.levels_v_per_m[i]);
   }

@@ -1,0 +1,31 @@
+# Build helpers: the warning and sanitizer flags every target shares, and the library pattern.
+add_library(selfsense_build_flags INTERFACE)
+add_library(selfsense::build_flags ALIAS selfsense_build_flags)
+target_compile_options(selfsense_build_flags INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wsign-conversion -Wold-style-cast
+  -Wnon-virtual-dtor -Woverloaded-virtual -Wdouble-promotion
+  $<$<BOOL:${SELFSENSE_WERROR}>:-Werror>)
+if(SELFSENSE_SANITIZE)
+  target_compile_options(selfsense_build_flags INTERFACE
+    -fsanitize=${SELFSENSE_SANITIZE} -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  target_link_options(selfsense_build_flags INTERFACE -fsanitize=${SELFSENSE_SANITIZE})
+endif()
+
+# Registers a target for installation in the selfsense export set.
+function(selfsense_export target)
+  set_property(GLOBAL APPEND PROPERTY SELFSENSE_EXPORTED_TARGETS ${target})
+endfunction()
+
+# selfsense_library(<target> EXPORT_NAME <name> SOURCES ... [PUBLIC deps...] [PRIVATE deps...])
+# A library of the project: alias selfsense::<name>, the public include folder, the shared
+# flags, and a place in the export set.
+function(selfsense_library target)
+  cmake_parse_arguments(ARG "" "EXPORT_NAME" "SOURCES;PUBLIC;PRIVATE" ${ARGN})
+  add_library(${target} ${ARG_SOURCES})
+  add_library(selfsense::${ARG_EXPORT_NAME} ALIAS ${target})
+  target_include_directories(${target} PUBLIC
+    $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/include> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  target_link_libraries(${target} PUBLIC ${ARG_PUBLIC} PRIVATE ${ARG_PRIVATE} selfsense_build_flags)
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${ARG_EXPORT_NAME})
+  selfsense_export(${target})
+endfunction()
