@@ -460,7 +460,7 @@ void simulate_operator(const OperatorModel& model, std::span<const double> x,
   operators::HysteresisCreep op(model.op, model.sample_time);
   op.set_history(model.history);
   for (std::size_t k = 0; k < x.size(); ++k) {
-    double v = op.step(x[k]) + model.offset;
+    double v = op.step(x[k]) + model.offset + model.quadratic * x[k] * x[k];
     for (std::size_t u = 0; u < linear_inputs.size(); ++u) {
       v += model.linear_gains[u] * linear_inputs[u][k];
     }

@@ -67,6 +67,7 @@ std::optional<SideModel> read_side(YamlMap& root, std::string_view key, double t
   m.sample_time = ts;
   m.linear_gains = {side->optional<double>("coupling", 0.0)};
   side->read("offset", m.offset);
+  side->read("quadratic", m.quadratic);
   side->read_sequence("history", m.history);
   m.op = read_operator(*side);
   side->finish();
@@ -154,6 +155,7 @@ void emit_side(YAML::Emitter& out, const char* key, const SideModel& side) {
   out << YAML::Key << "coupling" << YAML::Value
       << (side.linear_gains.empty() ? 0.0 : side.linear_gains.front());
   out << YAML::Key << "offset" << YAML::Value << side.offset;
+  if (side.quadratic != 0.0) out << YAML::Key << "quadratic" << YAML::Value << side.quadratic;
   emit_sequence(out, "history", side.history);
   const auto& h = side.op.hysteresis;
   out << YAML::Key << "hysteresis" << YAML::Value << YAML::BeginMap;

@@ -20,7 +20,8 @@ std::optional<SideOperator> make_side(const std::optional<SideModel>& side) {
 SideOperator::SideOperator(const SideModel& model)
     : op_(model.op, model.sample_time),
       coupling_(model.linear_gains.empty() ? 0.0 : model.linear_gains.front()),
-      offset_(model.offset) {
+      offset_(model.offset),
+      quadratic_(model.quadratic) {
   op_.set_history(model.history);
 }
 

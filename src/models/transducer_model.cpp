@@ -33,7 +33,8 @@ bool side_valid(const char* name, const std::optional<SideModel>& side, double t
   for (const double g : side->linear_gains) {
     if (!operators::check::finite(std::string(name) + ".coupling", g, why)) return false;
   }
-  return operators::check::finite(std::string(name) + ".offset", side->offset, why);
+  return operators::check::finite(std::string(name) + ".offset", side->offset, why) &&
+         operators::check::finite(std::string(name) + ".quadratic", side->quadratic, why);
 }
 
 identification::OperatorStructure structure_of(const IdentificationOptions& o, bool creep) {
@@ -143,12 +144,25 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
         {signals.drive, linear, signals.sensed, signals.sample_time}, structure_of(options, creep));
   }
   if (usable(signals.strain)) {
-    // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19).
+    // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19);
+    // with charge drive it also has the electrostrictive term S ~ D^2, which makes the
+    // butterfly strain loops of bipolar drive past the coercive field.
     const bool linear_side =
         structure == Structure::kPermittivity || structure == Structure::kChargeDrive;
+    std::vector<double> squared;
+    std::vector<std::span<const double>> inputs = linear;
+    if (structure == Structure::kChargeDrive) {
+      squared.resize(n);
+      for (std::size_t k = 0; k < n; ++k) squared[k] = signals.drive[k] * signals.drive[k];
+      inputs.push_back(squared);
+    }
     model.actuator = identification::fit_operator(
-        {signals.drive, linear, signals.strain, signals.sample_time},
+        {signals.drive, inputs, signals.strain, signals.sample_time},
         linear_side ? identification::OperatorStructure{} : structure_of(options, creep));
+    if (!squared.empty()) {
+      model.actuator->quadratic = model.actuator->linear_gains.back();
+      model.actuator->linear_gains.pop_back();
+    }
   }
   return model;
 }

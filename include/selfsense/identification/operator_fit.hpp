@@ -55,6 +55,7 @@ struct OperatorModel {
   operators::HysteresisCreep::Params op{};
   std::vector<double> linear_gains{};  // g_k
   double offset{0.0};
+  double quadratic{0.0};          // y += quadratic * x^2 (electrostriction; set by the caller)
   std::vector<double> history{};  // input turning points before the first sample
   double sample_time{0.0};
 };

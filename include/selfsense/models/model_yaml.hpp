@@ -8,6 +8,7 @@
 //   sensor:                              # D = S[H[E] + K[E]] + coupling T + offset
 //     coupling: 3.0e-10                  # (charge drive: E = ... of D)
 //     offset: 0.0
+//     quadratic: 0.0                     # Q x^2, electrostriction (charge drive); optional
 //     history: [0.0, 2.0e6, 1.0e6]       # input turning points before the first sample
 //     hysteresis: {linear_weight, thresholds: [...], weights: [...]}
 //     superposition: {linear_weight, upper_thresholds, upper_weights,

@@ -21,8 +21,8 @@ namespace selfsense::models {
 class SideOperator final {
  public:
   explicit SideOperator(const SideModel& model);
-  // G[x] + y0 (advances the operator).
-  double step_unloaded(double x) noexcept { return op_.step(x) + offset_; }
+  // G[x] + y0 + quadratic x^2 (advances the operator).
+  double step_unloaded(double x) noexcept { return op_.step(x) + offset_ + quadratic_ * x * x; }
   [[nodiscard]] double coupling() const noexcept { return coupling_; }
   [[nodiscard]] const operators::HysteresisCreep& op() const noexcept { return op_; }
   [[nodiscard]] operators::HysteresisCreep& op() noexcept { return op_; }
@@ -31,6 +31,7 @@ class SideOperator final {
   operators::HysteresisCreep op_;
   double coupling_{0.0};
   double offset_{0.0};
+  double quadratic_{0.0};
 };
 
 // Saves and restores the states of up to two sides into one caller-owned buffer.

@@ -5,7 +5,8 @@
 //   S = Ga[E] + sE * T + S0         actuator side
 // Charge drive (D imposed; Jones and Garcia, eq. 16-21):
 //   E = Gs[D] + g' * T + E0         (g' = -g of eq. 18)
-//   S = Ga[D] + sD * T + S0
+//   S = Ga[D] + sD * T + Q * D^2 + S0   (Q: electrostriction, the butterfly loops past the
+//                                        coercive field; 0 for field drive)
 // G = S[H + K] is a hysteresis-creep operator (operators::HysteresisCreep); each structure fixes
 // which of its parts exist:
 //   linear            G = w0 * x                               (eq. 5-8)
