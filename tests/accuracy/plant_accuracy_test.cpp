@@ -65,32 +65,25 @@ Figures reconstruct(const models::TransducerModel& model, const Recorded& r) {
   return {fit_quality(r.t, t_hat), fit_quality(r.s, s_hat)};
 }
 
-class PlantAccuracy : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    identification_ = new Recorded(record_mix(1));
-    hysteresis_creep_ = new models::TransducerModel(
-        identify(*identification_, models::Structure::kHysteresisCreep));
-    linear_ = new models::TransducerModel(identify(*identification_, models::Structure::kLinear));
-  }
-  static void TearDownTestSuite() {
-    delete identification_;
-    delete hysteresis_creep_;
-    delete linear_;
-  }
-  static Recorded* identification_;
-  static models::TransducerModel* hysteresis_creep_;
-  static models::TransducerModel* linear_;
+// Identified once for the whole suite: seed 1 of the mix excitation.
+struct Identified {
+  models::TransducerModel hysteresis_creep;
+  models::TransducerModel linear;
 };
 
-Recorded* PlantAccuracy::identification_ = nullptr;
-models::TransducerModel* PlantAccuracy::hysteresis_creep_ = nullptr;
-models::TransducerModel* PlantAccuracy::linear_ = nullptr;
+const Identified& identified() {
+  static const Identified models = [] {
+    const Recorded r = record_mix(1);
+    return Identified{identify(r, models::Structure::kHysteresisCreep),
+                      identify(r, models::Structure::kLinear)};
+  }();
+  return models;
+}
 
-TEST_F(PlantAccuracy, SelfSensingOnAHeldOutRecordingMeetsTheGoals) {
+TEST(PlantAccuracy, SelfSensingOnAHeldOutRecordingMeetsTheGoals) {
   const Recorded validation = record_mix(2);  // other noise: not used to fit anything
-  const Figures hc = reconstruct(*hysteresis_creep_, validation);
-  const Figures lin = reconstruct(*linear_, validation);
+  const Figures hc = reconstruct(identified().hysteresis_creep, validation);
+  const Figures lin = reconstruct(identified().linear, validation);
   RecordProperty("S_hat_nrmse", std::to_string(hc.strain.nrmse));
   RecordProperty("T_hat_nrmse", std::to_string(hc.stress.nrmse));
   // Issue 4 goals: S_hat nrmse <= 0.3 %, max <= 1.5 %; T_hat nrmse <= 1.5 %.
@@ -126,9 +119,9 @@ double tracking_nrmse(const models::TransducerModel& model) {
   return fit_quality(desired, r.s).nrmse;
 }
 
-TEST_F(PlantAccuracy, InverseCompensationTracksAHeldOutTrajectory) {
-  const double compensated = tracking_nrmse(*hysteresis_creep_);
-  const double uncompensated = tracking_nrmse(*linear_);
+TEST(PlantAccuracy, InverseCompensationTracksAHeldOutTrajectory) {
+  const double compensated = tracking_nrmse(identified().hysteresis_creep);
+  const double uncompensated = tracking_nrmse(identified().linear);
   RecordProperty("compensated_nrmse", std::to_string(compensated));
   RecordProperty("uncompensated_nrmse", std::to_string(uncompensated));
   std::printf("tracking nrmse: compensated %.3f %%, linear inverse %.3f %%\n", 100 * compensated,

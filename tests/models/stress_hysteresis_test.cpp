@@ -74,8 +74,8 @@ Recorded stressed_stack() {
 
 TEST(StressHysteresis, ReconstructsStressWhereTheAffineModelCannot) {
   const Recorded r = stressed_stack();
-  const std::size_t split = 40000;
-  const auto head = [split](const std::vector<double>& v) { return std::span(v).first(split); };
+  constexpr std::size_t kSplit = 40000;
+  const auto head = [](const std::vector<double>& v) { return std::span(v).first(kSplit); };
   const StressHysteresisModel model =
       fit_stress_hysteresis(head(r.e), head(r.t), head(r.d), head(r.s), 1e-3, 16);
   const TransducerModel affine =
@@ -89,13 +89,13 @@ TEST(StressHysteresis, ReconstructsStressWhereTheAffineModelCannot) {
   for (std::size_t k = 0; k < r.e.size(); ++k) {
     const auto v = vectorial.step(r.e[k], r.d[k]);
     const auto a = scalar.step(r.e[k], r.d[k]);
-    if (k >= split) {
+    if (k >= kSplit) {
       t_vec.push_back(v.stress);
       t_aff.push_back(a.stress);
       s_vec.push_back(v.strain);
     }
   }
-  const auto held = [split](const std::vector<double>& v) { return std::span(v).subspan(split); };
+  const auto held = [](const std::vector<double>& v) { return std::span(v).subspan(kSplit); };
   const auto q_vec = fit_quality(held(r.t), t_vec);
   const auto q_aff = fit_quality(held(r.t), t_aff);
   const auto q_s = fit_quality(held(r.s), s_vec);
