@@ -40,10 +40,11 @@ ModelRuns run_vectorial(const models::StressHysteresisModel& m, const FieldSigna
     const auto& c = r.status_counts();
     runs.solver_failures = n - c[static_cast<std::size_t>(models::SolveStatus::kOk)];
     if (runs.solver_failures > 0) {
-      std::fprintf(stderr,
-                   "warning: stress not uniquely reconstructed at %zu of %zu samples (no solution "
-                   "%zu, D-T not monotone %zu, not converged %zu)\n",
-                   runs.solver_failures, n, c[1], c[2], c[3]);
+      static_cast<void>(std::fprintf(
+          stderr,
+          "warning: stress not uniquely reconstructed at %zu of %zu samples (no solution "
+          "%zu, D-T not monotone %zu, not converged %zu)\n",
+          runs.solver_failures, n, c[1], c[2], c[3]));
     }
   }
   return runs;

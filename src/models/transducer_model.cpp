@@ -153,8 +153,9 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
     std::vector<std::span<const double>> inputs = linear;
     if (structure == Structure::kChargeDrive) {
       squared.resize(n);
-      for (std::size_t k = 0; k < n; ++k) squared[k] = signals.drive[k] * signals.drive[k];
-      inputs.push_back(squared);
+      for (std::size_t k = 0; k < n; ++k)
+        squared[k] = signals.drive[k] * signals.drive[k];
+      inputs.emplace_back(squared);
     }
     model.actuator = identification::fit_operator(
         {signals.drive, inputs, signals.strain, signals.sample_time},
