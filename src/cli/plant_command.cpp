@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -19,6 +20,7 @@
 #include "selfsense/plant/excitation.hpp"
 #include "selfsense/plant/plant.hpp"
 #include "selfsense/plant/plant_yaml.hpp"
+#include "selfsense/runtime/pacer.hpp"
 
 namespace selfsense::cli {
 namespace {
@@ -28,7 +30,27 @@ struct PlantOptions {
   std::optional<std::uint64_t> seed{};
   std::string excitation{};
   std::filesystem::path out{};
+  bool realtime{false};
 };
+
+// Steps the plant paced to its sample rate on the monotonic clock, as the daemon's simulated
+// backend will; reports the overruns.
+std::vector<plant::StepOutput> run_paced(const plant::PlantConfig& config,
+                                         const std::vector<plant::StepInput>& inputs) {
+  plant::Plant p(config);
+  std::vector<plant::StepOutput> out(inputs.size());
+  runtime::SteadyClock clock;
+  runtime::Pacer pacer(clock, std::llround(1e9 / config.sample_rate_hz));
+  pacer.start();
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    out[k] = p.step(inputs[k]);
+    static_cast<void>(pacer.wait());
+  }
+  std::printf("selfsense plant: paced in real time, %lld overruns (worst %.1f us late)\n",
+              static_cast<long long>(pacer.overruns()),
+              1e-3 * static_cast<double>(pacer.worst_late_ns()));
+  return out;
+}
 
 // Linear interpolation of a recorded column onto the plant's sample grid.
 std::vector<double> resample(std::span<const double> t, std::span<const double> v, double t0,
@@ -75,7 +97,8 @@ void run_plant(const PlantOptions& opt) {
   }
 
   const std::vector<plant::StepInput> inputs = ex.inputs();
-  std::vector<plant::StepOutput> out = plant::simulate(file.plant, inputs);
+  std::vector<plant::StepOutput> out =
+      opt.realtime ? run_paced(file.plant, inputs) : plant::simulate(file.plant, inputs);
   // Recordings hold finite numbers only (contracts.md): a NaN fault keeps its status bit and
   // repeats the previous delivered value in the file.
   for (std::size_t k = 0; k < out.size(); ++k) {
@@ -158,6 +181,9 @@ void add_plant_command(CLI::App& app) {
                   "steps | sines | decaying | noise | mix | csv:PATH (E, optional F_ext and temp)")
       ->required();
   cmd->add_option("--out", opt->out, "recording to write (CSV)")->required();
+  cmd->add_flag("--realtime", opt->realtime,
+                "pace the plant to its sample rate on the monotonic clock (default: as fast as "
+                "possible, simulated time)");
   cmd->callback([opt] { run_plant(*opt); });
 }
 

@@ -47,6 +47,14 @@ grep -q '^vectorial:' "$work/v.yaml" || fail "stress-hysteresis model has no vec
 "$bin" reconstruct --model "$work/v.yaml" --recording "$work/r.csv" --out "$work/vrec.csv" 2>/dev/null
 head -n 20 "$work/vrec.csv" | grep -q 'T_hat' || fail "vectorial reconstruct wrote no T_hat"
 
+# The paced plant (the daemon's simulated backend): real time at 1 kHz, overruns reported.
+printf 'plant:\n  sample_rate_hz: 1000\nexcitation:\n  steps: {levels_v_per_m: [1.0e6, 0.0], hold_s: 0.1}\n' >"$work/paced.yaml"
+start=$(date +%s%N)
+"$bin" plant --config "$work/paced.yaml" --excitation steps --out "$work/paced.csv" --realtime >"$work/paced.txt"
+elapsed_ms=$(( ($(date +%s%N) - start) / 1000000 ))
+grep -q 'paced in real time' "$work/paced.txt" || fail "no pacing report"
+[ "$elapsed_ms" -ge 150 ] || fail "paced run of about 0.2 s took only $elapsed_ms ms"
+
 # Bad input: a clear one-line error naming file, line and column, and a non-zero status.
 printf 't,E,D\n0,1,2\n0.001,abc,3\n' >"$work/bad.csv"
 if "$bin" reconstruct --model "$work/m.yaml" --recording "$work/bad.csv" --out "$work/x.csv" 2>"$work/err.txt"; then

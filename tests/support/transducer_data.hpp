@@ -28,7 +28,8 @@ inline models::TransducerModel typical_transducer(double ts) {
   m.structure = models::Structure::kHysteresisCreep;
   m.sample_time = ts;
   const std::vector<double> history{0.0, 2e6, 1e6};
-  m.sensor = models::SideModel{operators::typical_stack_charge(size), {3e-10}, 0.0, 0.0, history, ts};
+  m.sensor =
+      models::SideModel{operators::typical_stack_charge(size), {3e-10}, 0.0, 0.0, history, ts};
   m.actuator =
       models::SideModel{operators::typical_stack_strain(size), {2e-11}, 0.0, 0.0, history, ts};
   return m;

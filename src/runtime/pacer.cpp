@@ -1,0 +1,59 @@
+#include "selfsense/runtime/pacer.hpp"
+
+#include <cassert>
+#include <cerrno>
+#include <ctime>
+
+namespace selfsense::runtime {
+namespace {
+
+constexpr std::int64_t kNsPerS = 1'000'000'000;
+
+}  // namespace
+
+std::int64_t SteadyClock::now_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * kNsPerS + ts.tv_nsec;
+}
+
+void SteadyClock::sleep_until_ns(std::int64_t t) noexcept {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(t / kNsPerS);
+  ts.tv_nsec = static_cast<long>(t % kNsPerS);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+Pacer::Pacer(Clock& clock, std::int64_t period_ns) noexcept
+    : clock_(&clock), period_ns_(period_ns) {
+  assert(period_ns > 0);
+}
+
+void Pacer::start() noexcept {
+  start_ns_ = clock_->now_ns();
+  cycle_ = 0;
+}
+
+Pacer::Tick Pacer::wait() noexcept {
+  ++cycle_;
+  Tick tick;
+  const std::int64_t now = clock_->now_ns();
+  std::int64_t deadline = start_ns_ + cycle_ * period_ns_;
+  if (now > deadline) {
+    tick.overrun = true;
+    tick.late_ns = now - deadline;
+    ++overruns_;
+    last_overrun_cycle_ = cycle_;
+    if (tick.late_ns > worst_late_ns_) worst_late_ns_ = tick.late_ns;
+    // The next deadline still ahead: skip the missed ones rather than burst.
+    cycle_ = (now - start_ns_) / period_ns_ + 1;
+    deadline = start_ns_ + cycle_ * period_ns_;
+  }
+  clock_->sleep_until_ns(deadline);
+  tick.cycle = cycle_;
+  tick.deadline_ns = deadline;
+  return tick;
+}
+
+}  // namespace selfsense::runtime
