@@ -1,6 +1,7 @@
 #include "selfsense/identification/nnls.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -140,6 +141,14 @@ void GramAccumulator::add(const Eigen::Ref<const Eigen::MatrixXd>& rows,
   moment_.noalias() += rows.transpose() * y;
   output_energy_ += y.squaredNorm();
   rows_ += static_cast<std::size_t>(rows.rows());
+}
+
+void GramAccumulator::add(const GramAccumulator& other) {
+  assert(other.lower_.rows() == lower_.rows());
+  lower_ += other.lower_;
+  moment_ += other.moment_;
+  output_energy_ += other.output_energy_;
+  rows_ += other.rows_;
 }
 
 Eigen::MatrixXd GramAccumulator::gram() const {

@@ -39,18 +39,20 @@ BoundedLeastSquaresSolution solve(const GramAccumulator& acc, const Bounds& boun
        Eigen::Map<const Eigen::VectorXd>(bounds.lower.data(), bounds.size())});
 }
 
-// Streams rows over samples [0, count): fill(k, phi, row, target) writes one row, given the
-// operator columns phi of sample k.
+// Streams rows over samples [from, count) (the operator still runs from sample 0):
+// fill(k, phi, row, target) writes one row, given the operator columns phi of sample k.
 template <typename Fill>
 GramAccumulator accumulate(const OperatorBasis& basis, std::span<const double> x,
                            std::span<const double> history, std::size_t count, Eigen::Index cols,
-                           Fill fill) {
+                           Fill fill, std::size_t from = 0) {
   GramAccumulator acc(cols);
   RegressorStream stream(basis, history);
+  for (std::size_t k = 0; k < from && k < count; ++k)
+    static_cast<void>(stream.next(x[k]));
   RowBlock block(kBlockRows, cols);
   Eigen::VectorXd target(kBlockRows);
   Eigen::Index row = 0;
-  for (std::size_t k = 0; k < count; ++k) {
+  for (std::size_t k = from; k < count; ++k) {
     fill(k, stream.next(x[k]),
          std::span<double>(block.row(row).data(), static_cast<std::size_t>(cols)), target(row));
     if (++row == kBlockRows) {
@@ -80,14 +82,26 @@ class Fitter {
 
   // Everything linear, S = identity. Returns the fit and its residual sum of squares.
   [[nodiscard]] Fit linear(std::span<const double> history, std::size_t count) const {
+    return solve_linear(linear_gram(history, 0, count));
+  }
+
+  // Normal equations of the linear stage over samples [from, to).
+  [[nodiscard]] GramAccumulator linear_gram(std::span<const double> history, std::size_t from,
+                                            std::size_t to) const {
     const std::size_t ops = basis_.columns();
     const auto cols = static_cast<Eigen::Index>(ops + extras());
-    const GramAccumulator acc = accumulate(basis_, s_.input, history, count, cols,
-                                           [&](std::size_t k, auto phi, auto row, double& y) {
-                                             std::copy(phi.begin(), phi.end(), row.begin());
-                                             fill_extras(k, row.subspan(ops), 1.0);
-                                             y = s_.output[k];
-                                           });
+    return accumulate(
+        basis_, s_.input, history, to, cols,
+        [&](std::size_t k, auto phi, auto row, double& y) {
+          std::copy(phi.begin(), phi.end(), row.begin());
+          fill_extras(k, row.subspan(ops), 1.0);
+          y = s_.output[k];
+        },
+        from);
+  }
+
+  [[nodiscard]] Fit solve_linear(const GramAccumulator& acc) const {
+    const std::size_t ops = basis_.columns();
     const BoundedLeastSquaresSolution sol = solve(acc, operator_bounds(true));
     Fit fit;
     fit.theta = sol.theta.head(static_cast<Eigen::Index>(ops));
@@ -304,7 +318,7 @@ std::vector<double> refine_turning_point(std::vector<double> h, double step, Res
   double d = a + kGolden * (b - a);
   double fc = at(c);
   double fd = at(d);
-  for (int i = 0; i < 10; ++i) {
+  for (int i = 0; i < 8; ++i) {  // brackets the turning point to 2 % of the step
     if (fc < fd) {
       b = d;
       d = c;
@@ -387,9 +401,20 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
   if (structure.estimate_history && structure.plays > 0) {
     // The start state matters until the input has swept its whole range (wiping-out), so
     // twice that span decides between candidates.
-    const std::size_t head =
-        std::min(n, std::max<std::size_t>(2 * sweep_length(signals.input), 2000));
-    const auto residual = [&](const std::vector<double>& h) { return fitter.linear(h, head).rss; };
+    const std::size_t sweep = std::min(n, sweep_length(signals.input));
+    const std::size_t head = std::min(n, std::max<std::size_t>(2 * sweep, 2000));
+    // Scored with the plays alone: the creep columns cost most of the normal equations and say
+    // little about where the plays started. After the sweep every candidate's plays are wiped
+    // to the same state, so the rows of [sweep, head) are shared: accumulated once.
+    OperatorBasis plays_only = basis;
+    plays_only.creep_rows.clear();
+    const Fitter scorer(signals, plays_only, weight_floor, structure.fit_offset);
+    const GramAccumulator shared = scorer.linear_gram({&signals.input.front(), 1}, sweep, head);
+    const auto residual = [&](const std::vector<double>& h) {
+      GramAccumulator acc = scorer.linear_gram(h, 0, sweep);
+      acc.add(shared);
+      return scorer.solve_linear(acc).rss;
+    };
     std::vector<std::pair<double, std::vector<double>>> ranked;
     for (std::vector<double>& candidate : history_candidates(signals.input)) {
       ranked.emplace_back(residual(candidate), std::move(candidate));

@@ -50,6 +50,8 @@ class GramAccumulator final {
   // rows: block of regressor rows (k x n); y: the k matching outputs.
   void add(const Eigen::Ref<const Eigen::MatrixXd>& rows,
            const Eigen::Ref<const Eigen::VectorXd>& y);
+  // Adds the rows another accumulator has seen (same column count, asserted).
+  void add(const GramAccumulator& other);
   [[nodiscard]] Eigen::MatrixXd gram() const;  // full symmetric matrix
   [[nodiscard]] const Eigen::VectorXd& moment() const noexcept { return moment_; }
   [[nodiscard]] double output_energy() const noexcept { return output_energy_; }
