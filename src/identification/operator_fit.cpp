@@ -112,14 +112,13 @@ class Fitter {
 
   // Kuhnen's equation error: S'[y - g u - offset] = theta . phi with S' = S^-1 in the slope
   // basis, its slope around 0 fixed at 1; g and offset kept from `from`.
-  [[nodiscard]] Fit equation_error(const Fit& from, std::span<const double> history,
-                                   std::size_t per_side) const {
+  [[nodiscard]] Fit equation_error(const Fit& from, std::size_t per_side) const {
     const std::vector<double> inner = unloaded(from);
     const DeadZoneBasis dz = spread_dead_zones(inner, per_side);
     const std::size_t ops = basis_.columns();
     const std::size_t shape_cols = dz.columns() - 1;
     std::vector<double> b(dz.columns());
-    const GramAccumulator acc = accumulate(basis_, s_.input, history, inner.size(),
+    const GramAccumulator acc = accumulate(basis_, s_.input, history_, inner.size(),
                                            static_cast<Eigen::Index>(ops + shape_cols),
                                            [&](std::size_t k, auto phi, auto row, double& y) {
                                              std::copy(phi.begin(), phi.end(), row.begin());
@@ -142,8 +141,8 @@ class Fitter {
   }
 
   // Output error for S, g and offset with theta fixed (linear in them given v = theta . phi).
-  [[nodiscard]] Fit refit_shape(const Fit& from, std::span<const double> history) const {
-    const std::vector<double> inner = unloaded_inner(from, history);
+  [[nodiscard]] Fit refit_shape(const Fit& from) const {
+    const std::vector<double> inner = unloaded_inner(from);
     DeadZoneBasis dz{from.shape.upper_thresholds, from.shape.lower_thresholds};
     const std::size_t shape_cols = dz.columns();
     const auto cols = static_cast<Eigen::Index>(shape_cols + extras());
@@ -171,19 +170,19 @@ class Fitter {
     std::vector<double> slopes(sol.theta.data(), sol.theta.data() + shape_cols);
     fit.shape = dz.superposition(slopes);
     unpack_extras(sol.theta, shape_cols, fit);
-    fit.rss = output_rss(fit, history);
+    fit.rss = output_rss(fit);
     return fit;
   }
 
   // Gauss-Newton step for theta, g and offset with S fixed: S is piecewise linear, so around
   // v0 = theta0 . phi, S(v) = S(v0) + S'(v0) (v - v0) exactly while v stays on its segment.
-  [[nodiscard]] Fit refit_operator(const Fit& from, std::span<const double> history) const {
+  [[nodiscard]] Fit refit_operator(const Fit& from) const {
     const DeadZoneSuperposition shape(from.shape);
-    const std::vector<double> v0 = unloaded_inner(from, history);
+    const std::vector<double> v0 = unloaded_inner(from);
     const std::size_t ops = basis_.columns();
     const auto cols = static_cast<Eigen::Index>(ops + extras());
     const GramAccumulator acc =
-        accumulate(basis_, s_.input, history, v0.size(), cols,
+        accumulate(basis_, s_.input, history_, v0.size(), cols,
                    [&](std::size_t k, auto phi, auto row, double& y) {
                      const double slope = shape.slope(v0[k]);
                      for (std::size_t i = 0; i < ops; ++i)
@@ -195,7 +194,7 @@ class Fitter {
     Fit fit = from;
     fit.theta = sol.theta.head(static_cast<Eigen::Index>(ops));
     unpack_extras(sol.theta, ops, fit);
-    fit.rss = output_rss(fit, history);
+    fit.rss = output_rss(fit);
     return fit;
   }
 
@@ -238,9 +237,8 @@ class Fitter {
   }
 
   // v = theta . phi over the fitted samples.
-  [[nodiscard]] std::vector<double> unloaded_inner(const Fit& fit,
-                                                   std::span<const double> history) const {
-    RegressorStream stream(basis_, history);
+  [[nodiscard]] std::vector<double> unloaded_inner(const Fit& fit) const {
+    RegressorStream stream(basis_, history_);
     std::vector<double> v(s_.output.size());
     for (std::size_t k = 0; k < v.size(); ++k) {
       const std::span<const double> phi = stream.next(s_.input[k]);
@@ -250,10 +248,9 @@ class Fitter {
     return v;
   }
 
-  [[nodiscard]] double output_rss(const Fit& fit) const { return output_rss(fit, history_); }
-  [[nodiscard]] double output_rss(const Fit& fit, std::span<const double> history) const {
+  [[nodiscard]] double output_rss(const Fit& fit) const {
     const DeadZoneSuperposition shape(fit.shape);
-    const std::vector<double> v = unloaded_inner(fit, history);
+    const std::vector<double> v = unloaded_inner(fit);
     double rss = 0.0;
     for (std::size_t k = 0; k < v.size(); ++k) {
       double y = shape.evaluate(v[k]) + fit.offset;
@@ -445,12 +442,12 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
   // that refit S and the operator in turn, keeping whichever fit explains the data best.
   Fit fit = fitter.linear(history, n);
   if (structure.dead_zones > 0) {
-    Fit candidate = fitter.equation_error(fit, history, structure.dead_zones);
+    Fit candidate = fitter.equation_error(fit, structure.dead_zones);
     Fit best = candidate;
     for (std::size_t pass = 0; pass < structure.refinement_passes; ++pass) {
-      candidate = fitter.refit_shape(candidate, history);
+      candidate = fitter.refit_shape(candidate);
       if (candidate.rss < best.rss) best = candidate;
-      candidate = fitter.refit_operator(candidate, history);
+      candidate = fitter.refit_operator(candidate);
       if (candidate.rss < best.rss) best = candidate;
     }
     fit = best;
