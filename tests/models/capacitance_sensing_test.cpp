@@ -9,6 +9,7 @@
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/operators/parameter_error.hpp"
 #include "selfsense/plant/plant.hpp"
+#include "support/stressed_stack.hpp"
 
 namespace selfsense::models {
 namespace {
@@ -34,15 +35,7 @@ TEST(CapacitanceEstimator, IgnoresNonFiniteSamplesAndRejectsBadParameters) {
 // permittivity follows the stress (plant stress effects), so the estimated capacitance gives
 // the force without any charge-balance model of the load.
 TEST(CapacitanceSensing, StressFromTheEstimatedCapacitanceOfAStressedStack) {
-  plant::PlantConfig c;
-  c.sample_rate_hz = 10000.0;
-  c.hysteresis.enabled = true;
-  c.stress.enabled = true;
-  c.mechanics.enabled = false;
-  c.mechanics.load_stiffness_n_per_m = 0.0;
-  c.mechanics.load_force_n = -800.0;
-  c.sensors.e.noise_std = 200.0;
-  c.sensors.d.noise_std = 2e-6;
+  const plant::PlantConfig c = test::stressed_stack(10000.0, 2e-6);
   plant::Plant p(c);
   CapacitanceEstimator est({1.0 - 1.0 / 200.0, 2e-8, 1e-6, 0.0});  // memory 20 ms
   std::vector<double> cap;

@@ -9,6 +9,7 @@
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/models/reconstructor.hpp"
 #include "selfsense/plant/plant.hpp"
+#include "support/stressed_stack.hpp"
 
 namespace selfsense::models {
 namespace {
@@ -47,16 +48,7 @@ struct Recorded {
 };
 
 Recorded stressed_stack() {
-  plant::PlantConfig c;
-  c.sample_rate_hz = 1000.0;
-  c.hysteresis.enabled = true;
-  c.stress.enabled = true;
-  c.mechanics.enabled = false;
-  c.mechanics.load_stiffness_n_per_m = 0.0;
-  c.mechanics.load_force_n = -800.0;
-  c.sensors.e.noise_std = 200.0;
-  c.sensors.d.noise_std = 7e-6;
-  plant::Plant p(c);
+  plant::Plant p(test::stressed_stack(1000.0, 7e-6));
   Recorded r;
   for (int k = 0; k < 60000; ++k) {
     const double time = k * 1e-3;
