@@ -41,6 +41,18 @@ std::span<const double> RegressorStream::next(double x) noexcept {
   return row_;
 }
 
+void RegressorStream::save_state(std::span<double> out) const noexcept {
+  assert(out.size() == state_size());
+  std::copy(plays_.begin(), plays_.end(), out.begin());
+  std::copy(lags_.begin(), lags_.end(), out.begin() + static_cast<std::ptrdiff_t>(plays_.size()));
+}
+
+void RegressorStream::restore_state(std::span<const double> in) noexcept {
+  assert(in.size() == state_size());
+  std::copy_n(in.begin(), plays_.size(), plays_.begin());
+  std::copy(in.begin() + static_cast<std::ptrdiff_t>(plays_.size()), in.end(), lags_.begin());
+}
+
 void DeadZoneBasis::evaluate(double v, std::span<double> out) const noexcept {
   assert(out.size() == columns());
   const auto side = [v](const std::vector<double>& d, bool up, std::span<double> cols) {

@@ -98,5 +98,22 @@ TEST(StressHysteresis, ReconstructsStressWhereTheAffineModelCannot) {
   EXPECT_EQ(vectorial.status_counts()[static_cast<std::size_t>(SolveStatus::kOk)], r.e.size());
 }
 
+TEST(StressHysteresis, StateSaveAndRestoreReplaysExactly) {
+  const Recorded r = stressed_stack();
+  StressHysteresisReconstructor rec(
+      fit_stress_hysteresis(std::span(r.e).first(20000), std::span(r.t).first(20000),
+                            std::span(r.d).first(20000), std::span(r.s).first(20000), 1e-3, 8));
+  for (std::size_t k = 0; k < 1000; ++k)
+    rec.step(r.e[k], r.d[k]);
+  std::vector<double> saved(rec.state_size());
+  rec.save_state(saved);
+  std::vector<double> first;
+  for (std::size_t k = 1000; k < 2000; ++k)
+    first.push_back(rec.step(r.e[k], r.d[k]).stress);
+  rec.restore_state(saved);
+  for (std::size_t k = 1000; k < 2000; ++k)
+    ASSERT_EQ(rec.step(r.e[k], r.d[k]).stress, first[k - 1000]);
+}
+
 }  // namespace
 }  // namespace selfsense::models

@@ -33,8 +33,13 @@ struct OperatorBasis {
 class RegressorStream {
  public:
   RegressorStream(const OperatorBasis& basis, std::span<const double> history);
-  // Advances with input x; the returned view is valid until the next call.
+  // Advances with input x; the returned view is valid until the next call. Real-time safe.
   std::span<const double> next(double x) noexcept;
+
+  // State: the plays, then the creep lags. Saving and restoring copy, never allocate.
+  [[nodiscard]] std::size_t state_size() const noexcept { return plays_.size() + lags_.size(); }
+  void save_state(std::span<double> out) const noexcept;
+  void restore_state(std::span<const double> in) noexcept;
 
  private:
   const OperatorBasis* basis_;

@@ -69,6 +69,10 @@ class StressHysteresisForward final {
   StressHysteresisForward& operator=(StressHysteresisForward&&) = delete;
   ~StressHysteresisForward() = default;
   Output step(double e, double t) noexcept;
+  // The field history (plays); saved into and restored from caller buffers, no allocation.
+  [[nodiscard]] std::size_t state_size() const noexcept { return stream_.state_size(); }
+  void save_state(std::span<double> out) const noexcept { stream_.save_state(out); }
+  void restore_state(std::span<const double> in) noexcept { stream_.restore_state(in); }
 
  private:
   StressHysteresisModel model_;  // the stream below points into it: not copyable
@@ -91,6 +95,9 @@ class StressHysteresisReconstructor final {
   StressHysteresisReconstructor& operator=(StressHysteresisReconstructor&&) = delete;
   ~StressHysteresisReconstructor() = default;
   Estimate step(double e, double d) noexcept;
+  [[nodiscard]] std::size_t state_size() const noexcept { return stream_.state_size(); }
+  void save_state(std::span<double> out) const noexcept { stream_.save_state(out); }
+  void restore_state(std::span<const double> in) noexcept { stream_.restore_state(in); }
   // How often each SolveStatus occurred, indexed by its value.
   [[nodiscard]] const std::array<std::size_t, 4>& status_counts() const noexcept { return counts_; }
 
