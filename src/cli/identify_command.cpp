@@ -101,7 +101,7 @@ void run_identify(const IdentifyOptions& opt) {
     return v.empty() ? std::span<const double>{} : std::span<const double>(v).first(split);
   };
   const auto sensed = signals.sensed(drive);
-  const models::TransducerSignals part{head(drive == models::Drive::kField ? signals.e : signals.d),
+  const models::TransducerSignals part{signals.drive(drive).first(split),
                                        sensed.empty() ? sensed : sensed.first(split),
                                        head(signals.stress), head(signals.s), signals.sample_time};
   if (sensed.empty())
