@@ -30,17 +30,10 @@ step() {  # runs a selfsense step quietly; its output is shown only when it fail
   fi
 }
 
-# identify, and if the recording without T makes it fail, again with an explicit T = 0 column:
-# `identify` reads the stress coupling of the fitted sides with .at(0), which throws when the
-# recording had no T (reported upstream; the figures are the same with T = 0).
 identify() {  # identify REC STRUCTURE MODEL [options...]
   local rec=$1 structure=$2 model=$3
   shift 3
-  if "$bin" identify --recording "$rec" --structure "$structure" --out "$model" "$@" \
-    >"$work/step.txt" 2>&1; then return 0; fi
-  awk -F, 'BEGIN { OFS = "," } /^#/ { print; next } !h { print $0 ",T"; h = 1; next }
-           { print $0 ",0" }' "$rec" >"${rec%.csv}_t0.csv"
-  step identify --recording "${rec%.csv}_t0.csv" --structure "$structure" --out "$model" "$@"
+  step identify --recording "$rec" --structure "$structure" --out "$model" "$@"
 }
 
 printf '%-26s %-16s %-28s %-4s %9s %9s  %s\n' set structure split chan "nrmse %" "max %" goal
