@@ -32,23 +32,7 @@ bool HysteresisCreep::Params::is_valid(std::string* why) const {
 HysteresisCreep::Params HysteresisCreep::with_nonlinear_creep(
     const PrandtlIshlinskii::Params& hysteresis, const DeadZoneSuperposition::Params& shape,
     const LinearCreep::Params& creep) {
-  std::string why;
-  require_valid(creep.is_valid(&why), why);
-  ThresholdCreep::Params elements;
-  elements.thresholds.push_back(0.0);
-  elements.thresholds.insert(elements.thresholds.end(), hysteresis.thresholds.begin(),
-                             hysteresis.thresholds.end());
-  elements.eigenvalues = creep.eigenvalues;
-  std::vector<double> w{hysteresis.linear_weight};
-  w.insert(w.end(), hysteresis.weights.begin(), hysteresis.weights.end());
-  for (std::size_t i = 0; i < w.size(); ++i) {
-    require_valid(w[i] >= 0.0, "HysteresisCreep.with_nonlinear_creep: hysteresis weight " +
-                                   std::to_string(i) +
-                                   " is negative; L[H[x]] then needs negative creep weights");
-    for (const double cj : creep.weights)
-      elements.weights.push_back(w[i] * cj);
-  }
-  return Params{hysteresis, shape, std::move(elements)};
+  return Params{hysteresis, shape, rank_one_creep(hysteresis, creep)};
 }
 
 HysteresisCreep::HysteresisCreep(Params params, double sample_time)

@@ -16,13 +16,7 @@ bool LinearCreep::Params::is_valid(std::string* why) const {
       !check::all_non_negative("LinearCreep.weights", weights, why)) {
     return false;
   }
-  for (std::size_t j = 0; j < eigenvalues.size(); ++j) {
-    if (!check::positive("LinearCreep.eigenvalues[" + std::to_string(j) + "]", eigenvalues[j],
-                         why)) {
-      return false;
-    }
-  }
-  return true;
+  return check::all_positive("LinearCreep.eigenvalues", eigenvalues, why);
 }
 
 LinearCreep::LinearCreep(Params params, double sample_time)

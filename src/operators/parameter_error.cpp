@@ -81,6 +81,13 @@ bool all_non_negative(std::string_view name, std::span<const double> values, std
   return true;
 }
 
+bool all_positive(std::string_view name, std::span<const double> values, std::string* why) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (!positive(indexed(name, i), values[i], why)) return false;
+  }
+  return true;
+}
+
 bool strictly_increasing_above(std::string_view name, std::span<const double> values,
                                double lower_bound, std::string* why) {
   return monotone_from(name, values, lower_bound, true, why);

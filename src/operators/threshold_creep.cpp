@@ -15,14 +15,9 @@ bool ThresholdCreep::Params::is_valid(std::string* why) const {
   // ordering check can never be the binding one.
   if (!check::all_non_negative("ThresholdCreep.thresholds", thresholds, why) ||
       !check::strictly_increasing_above("ThresholdCreep.thresholds", thresholds, -1.0, why) ||
-      !check::all_non_negative("ThresholdCreep.weights", weights, why)) {
+      !check::all_non_negative("ThresholdCreep.weights", weights, why) ||
+      !check::all_positive("ThresholdCreep.eigenvalues", eigenvalues, why)) {
     return false;
-  }
-  for (std::size_t j = 0; j < eigenvalues.size(); ++j) {
-    if (!check::positive("ThresholdCreep.eigenvalues[" + std::to_string(j) + "]", eigenvalues[j],
-                         why)) {
-      return false;
-    }
   }
   return check::same_size("ThresholdCreep.weights", weights.size(),
                           "ThresholdCreep.thresholds x eigenvalues",
@@ -86,22 +81,28 @@ void NonlinearCreep::apply(std::span<const double> x, std::span<double> y) noexc
     y[k] = step(x[k]);
 }
 
-ThresholdCreep::Params NonlinearCreep::as_threshold_creep() const {
-  const PrandtlIshlinskii::Params h = hysteresis_.params();
-  const LinearCreep::Params& l = creep_.params();
+ThresholdCreep::Params rank_one_creep(const PrandtlIshlinskii::Params& hysteresis,
+                                      const LinearCreep::Params& creep) {
+  std::string why;
+  require_valid(hysteresis.is_valid(&why) && creep.is_valid(&why), "rank_one_creep: " + why);
   ThresholdCreep::Params out;
   out.thresholds.push_back(0.0);
-  out.thresholds.insert(out.thresholds.end(), h.thresholds.begin(), h.thresholds.end());
-  out.eigenvalues = l.eigenvalues;
-  std::vector<double> w{h.linear_weight};
-  w.insert(w.end(), h.weights.begin(), h.weights.end());
-  for (const double wi : w) {
-    for (const double cj : l.weights)
-      out.weights.push_back(wi * cj);
+  out.thresholds.insert(out.thresholds.end(), hysteresis.thresholds.begin(),
+                        hysteresis.thresholds.end());
+  out.eigenvalues = creep.eigenvalues;
+  std::vector<double> w{hysteresis.linear_weight};
+  w.insert(w.end(), hysteresis.weights.begin(), hysteresis.weights.end());
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    require_valid(w[i] >= 0.0, "rank_one_creep: hysteresis weight " + std::to_string(i) +
+                                   " is negative; L[H[x]] then needs negative creep weights");
+    for (const double cj : creep.weights)
+      out.weights.push_back(w[i] * cj);
   }
-  std::string why;
-  require_valid(out.is_valid(&why), "NonlinearCreep.as_threshold_creep: " + why);
   return out;
+}
+
+ThresholdCreep::Params NonlinearCreep::as_threshold_creep() const {
+  return rank_one_creep(hysteresis_.params(), creep_.params());
 }
 
 }  // namespace selfsense::operators

@@ -33,6 +33,7 @@ bool positive(std::string_view name, double value, std::string* why);
 bool non_negative(std::string_view name, double value, std::string* why);
 bool all_finite(std::string_view name, std::span<const double> values, std::string* why);
 bool all_non_negative(std::string_view name, std::span<const double> values, std::string* why);
+bool all_positive(std::string_view name, std::span<const double> values, std::string* why);
 // Strictly increasing and every element > lower_bound (use 0 for positive thresholds).
 bool strictly_increasing_above(std::string_view name, std::span<const double> values,
                                double lower_bound, std::string* why);

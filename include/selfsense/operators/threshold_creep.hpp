@@ -65,6 +65,12 @@ class ThresholdCreep final {
   }
 };
 
+// Creep elements equal to L[H[x]]: thresholds {0, r_1..r_n}, weights c_ij = w_i c_j. Throws
+// ParameterError if either parameter set is invalid or a PI weight is negative (creep weights
+// must stay non-negative).
+[[nodiscard]] ThresholdCreep::Params rank_one_creep(const PrandtlIshlinskii::Params& hysteresis,
+                                                    const LinearCreep::Params& creep);
+
 class NonlinearCreep final {
  public:
   // Throws ParameterError if the creep parameters or sample time are invalid.
@@ -77,9 +83,8 @@ class NonlinearCreep final {
   [[nodiscard]] const PrandtlIshlinskii& hysteresis() const noexcept { return hysteresis_; }
   [[nodiscard]] const LinearCreep& creep() const noexcept { return creep_; }
 
-  // The same operator as creep elements with thresholds {0, r_1..r_n} and c_ij = w_i c_j.
-  // Exact only while every PI weight is >= 0 (creep weights must stay non-negative); throws
-  // ParameterError otherwise.
+  // The same operator as creep elements (rank_one_creep); throws ParameterError if a PI
+  // weight is negative.
   [[nodiscard]] ThresholdCreep::Params as_threshold_creep() const;
 
  private:
