@@ -17,9 +17,10 @@
 #include "commands.hpp"
 #include "field_signals.hpp"
 #include "model_runs.hpp"
+#include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/io/yaml_map.hpp"
-#include "selfsense/models/model_yaml.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
 
 namespace selfsense::cli {
 namespace {
@@ -89,7 +90,7 @@ void run_identify(const IdentifyOptions& opt) {
   if (split < 2)
     throw std::invalid_argument("--holdout or --fit-until leave fewer than 2 samples to fit");
 
-  models::IdentificationOptions sizes = models::defaults_for(*structure);
+  identification::IdentificationOptions sizes = identification::defaults_for(*structure);
   if (opt.plays >= 0) sizes.plays = static_cast<std::size_t>(opt.plays);
   if (opt.eigenvalues >= 0) sizes.eigenvalues = static_cast<std::size_t>(opt.eigenvalues);
   if (opt.creep_plays >= 0) sizes.creep_plays = static_cast<std::size_t>(opt.creep_plays);
@@ -101,9 +102,9 @@ void run_identify(const IdentifyOptions& opt) {
     return v.empty() ? std::span<const double>{} : std::span<const double>(v).first(split);
   };
   const auto sensed = signals.sensed(drive);
-  const models::TransducerSignals part{signals.drive(drive).first(split),
-                                       sensed.empty() ? sensed : sensed.first(split),
-                                       head(signals.stress), head(signals.s), signals.sample_time};
+  const identification::TransducerSignals part{
+      signals.drive(drive).first(split), sensed.empty() ? sensed : sensed.first(split),
+      head(signals.stress), head(signals.s), signals.sample_time};
   if (sensed.empty())
     std::printf("note: %s has no sensed channel: actuator side only\n", signals.source.c_str());
   if (signals.stress.empty()) {
@@ -111,7 +112,7 @@ void run_identify(const IdentifyOptions& opt) {
                 signals.source.c_str());
   }
   const auto start = std::chrono::steady_clock::now();
-  models::TransducerModel model = models::identify(part, *structure, sizes);
+  models::TransducerModel model = identification::identify(part, *structure, sizes);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   model.geometry = geometry;

@@ -10,7 +10,7 @@
 #include "field_signals.hpp"
 #include "model_runs.hpp"
 #include "selfsense/io/recording.hpp"
-#include "selfsense/models/model_yaml.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/operators/parameter_error.hpp"
 
 namespace selfsense::cli {

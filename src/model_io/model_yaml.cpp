@@ -1,4 +1,4 @@
-#include "selfsense/models/model_yaml.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
 
 #include <yaml-cpp/yaml.h>
 

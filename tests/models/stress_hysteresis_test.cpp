@@ -7,12 +7,18 @@
 #include <vector>
 
 #include "selfsense/identification/fit_quality.hpp"
+#include "selfsense/identification/stress_hysteresis_fit.hpp"
+#include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/models/reconstructor.hpp"
 #include "selfsense/plant/plant.hpp"
 #include "support/stressed_stack.hpp"
 
 namespace selfsense::models {
 namespace {
+
+using identification::defaults_for;
+using identification::fit_stress_hysteresis;
+using identification::identify;
 
 using identification::fit_quality;
 

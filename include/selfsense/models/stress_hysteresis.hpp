@@ -1,6 +1,6 @@
 // Stress-dependent hysteresis: the vectorial case of section 3.3 that the paper leaves as
 // future work, in a form that stays linear in its parameters. With q(E) the play columns of the
-// field history (identification/regressors.hpp: H[E] = W . q),
+// field history (operators/regressor_stream.hpp: H[E] = W . q),
 //   D = W0 . q + T (W1 . q) + d1 T + d2 T^2 + D0       sensor side
 //   S = A0 . q + T (A1 . q) + s1 T + s2 T^2 + S0       actuator side
 // so coupling, permittivity and hysteresis amplitude all change with stress. D is no longer
@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "selfsense/identification/regressors.hpp"
 #include "selfsense/models/bracketed_solver.hpp"
+#include "selfsense/operators/regressor_stream.hpp"
 
 namespace selfsense::models {
 
@@ -34,8 +34,8 @@ struct StressHysteresisSide {
 
 struct StressHysteresisModel {
   double sample_time{0.0};
-  identification::OperatorBasis basis{};  // plays only (no creep)
-  std::vector<double> history{};          // field turning points before the first sample
+  operators::OperatorBasis basis{};  // plays only (no creep)
+  std::vector<double> history{};     // field turning points before the first sample
   std::optional<StressHysteresisSide> sensor{};
   std::optional<StressHysteresisSide> actuator{};
   double stress_min{0.0};  // reconstruction bracket [Pa]
@@ -45,15 +45,6 @@ struct StressHysteresisModel {
   // ordered; names the field ("vectorial.sensor.base has 3 elements ...").
   [[nodiscard]] bool is_valid(std::string* why) const;
 };
-
-// Fits both sides by least squares (W0 partial sums bounded below so the field dependence stays
-// increasing, everything else free). The bracket is the recorded stress range widened by a tenth of
-// its span on each side. Throws std::invalid_argument on mismatched or empty signals.
-[[nodiscard]] StressHysteresisModel fit_stress_hysteresis(std::span<const double> e,
-                                                          std::span<const double> t,
-                                                          std::span<const double> d,
-                                                          std::span<const double> s,
-                                                          double sample_time, std::size_t plays);
 
 // Per-sample forward model (E, T -> D, S); allocation-free after construction.
 class StressHysteresisForward final {
@@ -76,7 +67,7 @@ class StressHysteresisForward final {
 
  private:
   StressHysteresisModel model_;  // the stream below points into it: not copyable
-  identification::RegressorStream stream_;
+  operators::RegressorStream stream_;
 };
 
 // Per-sample reconstruction; allocation-free after construction.
@@ -104,7 +95,7 @@ class StressHysteresisReconstructor final {
  private:
   StressHysteresisModel model_;  // the stream below points into it: not copyable
   SolverOptions options_{};
-  identification::RegressorStream stream_;
+  operators::RegressorStream stream_;
   std::array<std::size_t, 4> counts_{};
 };
 
