@@ -134,7 +134,12 @@ void run_identify(const IdentifyOptions& opt) {
                            {"seconds", seconds},
                            {"fit", to_json(fit)},
                            {"held_out", to_json(held)}};
-  if (runs.solver_failures > 0) report["solver_failures"] = runs.solver_failures;
+  if (!runs.estimate_status.empty()) {
+    report["estimate_status"] = to_json(runs.estimate_counts);
+    if (runs.estimate_counts.not_ok() > 0) {
+      std::printf("reconstruction status: %s\n", describe(runs.estimate_counts).c_str());
+    }
+  }
   // Couplings exist only when the recording had a stress channel.
   if (model.sensor && !model.sensor->linear_gains.empty()) {
     report["sensor_coupling"] = model.sensor->linear_gains.front();
@@ -148,14 +153,14 @@ void run_identify(const IdentifyOptions& opt) {
   if (!opt.validate.empty()) {
     const io::Recording vrec = io::read_recording_csv(opt.validate, io::ReadOptions{{"t"}});
     const FieldSignals vsig = field_signals(vrec, opt.validate.string(), geometry, drive);
-    if (std::abs(vsig.sample_time - signals.sample_time) > 0.01 * signals.sample_time) {
-      throw io::RecordingError(opt.validate.string() +
-                               ": sample time differs from the recording's");
-    }
-    const std::vector<ChannelFigures> val =
-        figures(model, vsig, run_model(model, vsig, true, true), 0, vsig.size());
-    std::printf("validation on %s (%zu samples):\n", vsig.source.c_str(), vsig.size());
+    const ModelRuns vruns = run_model(model, vsig, true, true);
+    const std::vector<ChannelFigures> val = figures(model, vsig, vruns, 0, vsig.size());
+    std::printf("validation on %s (%zu samples%s):\n", vsig.source.c_str(), vsig.size(),
+                vruns.rediscretised ? ", model re-discretised for its sample time" : "");
     print_table(val, {});
+    if (vruns.estimate_counts.not_ok() > 0) {
+      std::printf("reconstruction status: %s\n", describe(vruns.estimate_counts).c_str());
+    }
     report["validation"] = to_json(val);
   }
   if (!opt.json.empty()) {

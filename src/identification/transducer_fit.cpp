@@ -1,5 +1,6 @@
 #include "selfsense/identification/transducer_fit.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
@@ -19,6 +20,11 @@ OperatorStructure structure_of(const IdentificationOptions& o, bool creep) {
   s.fastest_eigenvalue = o.fastest_eigenvalue;
   s.slowest_eigenvalue = o.slowest_eigenvalue;
   return s;
+}
+
+models::InputRange range_of(std::span<const double> x) {
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  return {*lo, *hi};
 }
 
 }  // namespace
@@ -54,6 +60,8 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
   TransducerModel model;
   model.structure = structure;
   model.sample_time = signals.sample_time;
+  model.drive_range = range_of(signals.drive);
+  if (usable(signals.sensed)) model.sensed_range = range_of(signals.sensed);
   if (structure == Structure::kStressHysteresis) {
     if (signals.stress.empty()) {
       throw std::invalid_argument("identify: stress-hysteresis needs a stress channel (T or F)");

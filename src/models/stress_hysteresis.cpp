@@ -1,6 +1,7 @@
 #include "selfsense/models/stress_hysteresis.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -59,9 +60,42 @@ StressHysteresisForward::Output StressHysteresisForward::step(double e, double t
   return out;
 }
 
-StressHysteresisReconstructor::StressHysteresisReconstructor(StressHysteresisModel model,
-                                                             SolverOptions options)
-    : model_(std::move(model)), options_(options), stream_(model_.basis, model_.history) {
+namespace {
+
+struct StressSolution {
+  double stress{0.0};
+  SampleStatus status{SampleStatus::kOk};
+};
+
+// c T^2 + b T + (a - d) = 0 on the branch of the identified range [lo, hi] (header comment).
+StressSolution solve_quadratic_stress(double a, double b, double c, double d, double lo,
+                                      double hi) noexcept {
+  const double mid = 0.5 * (lo + hi);
+  const double f0 = a - d;
+  // |c| T^2 negligible against |b| T over the whole range: D is affine in T there.
+  const double reach = std::max(std::abs(lo), std::abs(hi));
+  if (std::abs(c) * reach <= 1e-12 * std::abs(b)) {
+    if (b == 0.0) return {mid, SampleStatus::kNoSolution};
+    return {-f0 / b, SampleStatus::kOk};
+  }
+  const double vertex = -b / (2.0 * c);
+  const SampleStatus shape =
+      (vertex > lo && vertex < hi) ? SampleStatus::kNotMonotone : SampleStatus::kOk;
+  const double disc = b * b - 4.0 * c * f0;
+  if (!(disc >= 0.0)) return {vertex, SampleStatus::kNoSolution};
+  const double slope_sign = (b + 2.0 * c * mid) >= 0.0 ? 1.0 : -1.0;
+  const double root = std::sqrt(disc);
+  // The branch root (-b + s root) / 2c, in the form that does not cancel.
+  const bool same_sign_as_b = (b >= 0.0) == (slope_sign > 0.0);
+  const double t =
+      same_sign_as_b ? -2.0 * f0 / (b + slope_sign * root) : (-b + slope_sign * root) / (2.0 * c);
+  return {t, shape};
+}
+
+}  // namespace
+
+StressHysteresisReconstructor::StressHysteresisReconstructor(StressHysteresisModel model)
+    : model_(std::move(model)), stream_(model_.basis, model_.history) {
   if (!model_.sensor) {
     throw std::invalid_argument("stress-hysteresis reconstruction needs a sensor side");
   }
@@ -71,11 +105,13 @@ StressHysteresisReconstructor::Estimate StressHysteresisReconstructor::step(doub
                                                                             double d) noexcept {
   const std::span<const double> q = stream_.next(e);
   const StressHysteresisSide& sensor = *model_.sensor;
-  const SolveResult r = solve_bracketed([&](double t) { return sensor.evaluate(q, t) - d; },
-                                        model_.stress_min, model_.stress_max, options_);
-  ++counts_[static_cast<std::size_t>(r.status)];
-  Estimate out{r.value, std::numeric_limits<double>::quiet_NaN(), r.status};
-  if (model_.actuator) out.strain = model_.actuator->evaluate(q, r.value);
+  const double a = operators::kernels::dot(sensor.base, q) + sensor.offset;
+  const double b = operators::kernels::dot(sensor.stress, q) + sensor.linear;
+  const StressSolution r =
+      solve_quadratic_stress(a, b, sensor.quadratic, d, model_.stress_min, model_.stress_max);
+  counts_.add(r.status);
+  Estimate out{r.stress, std::numeric_limits<double>::quiet_NaN(), r.status};
+  if (model_.actuator) out.strain = model_.actuator->evaluate(q, r.stress);
   return out;
 }
 

@@ -1,6 +1,7 @@
 #include "selfsense/models/transducer_model.hpp"
 
 #include <array>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -37,6 +38,15 @@ bool side_valid(const char* name, const std::optional<SideModel>& side, double t
          operators::check::finite(std::string(name) + ".quadratic", side->quadratic, why);
 }
 
+bool range_valid(const char* name, const std::optional<InputRange>& range, std::string* why) {
+  if (!range) return true;
+  if (std::isfinite(range->min) && std::isfinite(range->max) && range->max > range->min) {
+    return true;
+  }
+  if (why != nullptr) *why = std::string(name) + ": expected finite [min, max] with min < max";
+  return false;
+}
+
 }  // namespace
 
 std::string_view to_string(Structure s) noexcept {
@@ -68,6 +78,10 @@ Drive drive_of(Structure s) noexcept {
 
 bool TransducerModel::is_valid(std::string* why) const {
   if (!operators::check::positive("sample_time", sample_time, why)) return false;
+  if (!range_valid("input_range.drive", drive_range, why) ||
+      !range_valid("input_range.sensed", sensed_range, why)) {
+    return false;
+  }
   if (structure == Structure::kStressHysteresis) {
     if (!vectorial || (!vectorial->sensor && !vectorial->actuator)) {
       if (why != nullptr) *why = "model: stress-hysteresis needs its vectorial section";

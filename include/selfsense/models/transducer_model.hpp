@@ -50,6 +50,15 @@ enum class Drive { kField, kCharge };
 // All structure names, for messages: "linear, permittivity, ...".
 [[nodiscard]] std::string structure_names();
 
+// The range a channel covered in the identification recording: the runtime models reject
+// samples far outside it (models/runtime_model.hpp) instead of letting a spike wipe the
+// hysteresis memory.
+struct InputRange {
+  double min{0.0};
+  double max{0.0};
+  [[nodiscard]] double span() const noexcept { return max - min; }
+};
+
 struct TransducerModel {
   Structure structure{Structure::kLinear};
   double sample_time{0.0};              // [s]
@@ -57,6 +66,8 @@ struct TransducerModel {
   std::optional<SideModel> actuator{};  // x -> S
   std::optional<StressHysteresisModel> vectorial{};  // stress-hysteresis instead of the sides
   std::optional<Geometry> geometry{};                // for terminal quantities
+  std::optional<InputRange> drive_range{};           // x: E (field drive) or D (charge drive)
+  std::optional<InputRange> sensed_range{};          // y: D (field drive) or E (charge drive)
 
   [[nodiscard]] Drive drive() const noexcept { return drive_of(structure); }
   // The operator parameters and couplings are valid and the sample times agree.

@@ -34,6 +34,10 @@ class RegressorStream {
   // Advances with input x; the returned view is valid until the next call. Real-time safe.
   std::span<const double> next(double x) noexcept;
 
+  [[nodiscard]] const OperatorBasis& basis() const noexcept { return *basis_; }
+  [[nodiscard]] std::span<const double> plays() const noexcept { return plays_; }
+  [[nodiscard]] std::span<const double> lags() const noexcept { return lags_; }
+
   // State: the plays, then the creep lags. Saving and restoring copy, never allocate.
   [[nodiscard]] std::size_t state_size() const noexcept { return plays_.size() + lags_.size(); }
   void save_state(std::span<double> out) const noexcept;
