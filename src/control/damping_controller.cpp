@@ -1,6 +1,6 @@
 #include "selfsense/control/damping_controller.hpp"
 
-#include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <numbers>
 
@@ -21,6 +21,12 @@ bool DampingController::Params::is_valid(double sample_time, std::string* why) c
     return check::fail("DampingController.output_limit",
                        check::number(output_limit) + " must be > 0", why);
   }
+  if (!check::non_negative("DampingController.dc_block_frequency", dc_block_frequency, why) ||
+      (dc_block_frequency > 0.0 &&
+       !check::below("DampingController.dc_block_frequency", dc_block_frequency,
+                     kMaxDesignFraction / sample_time, "0.45 * sample rate", why))) {
+    return false;
+  }
   return law != Law::kPositivePosition ||
          check::positive("DampingController.damping", damping, why);
 }
@@ -38,11 +44,26 @@ DampingController::DampingController(const Params& params, double sample_time) :
     filter_ = Biquad(bilinear(AnalogBiquad{0.0, 1.0, 0.0, 0.0, tau, 1.0}, sample_time, 0.0));
     signed_gain_ = -params_.gain;
   }
+  if (params_.dc_block_frequency > 0.0) {
+    dc_block_ = Biquad(high_pass(FirstOrderDesign{params_.dc_block_frequency}, sample_time));
+  }
 }
 
-double DampingController::step(double measurement) noexcept {
-  return std::clamp(signed_gain_ * filter_.step(measurement), -params_.output_limit,
-                    params_.output_limit);
+void DampingController::reset(double measurement) noexcept {
+  dc_block_.reset(measurement);
+  filter_.reset(dc_block_.coefficients().dc_gain() * measurement);
+}
+
+void DampingController::save_state(std::span<double> out) const noexcept {
+  assert(out.size() >= kStateSize);
+  dc_block_.save_state(out.first(Biquad::kStateSize));
+  filter_.save_state(out.subspan(Biquad::kStateSize, Biquad::kStateSize));
+}
+
+void DampingController::restore_state(std::span<const double> in) noexcept {
+  assert(in.size() >= kStateSize);
+  dc_block_.restore_state(in.first(Biquad::kStateSize));
+  filter_.restore_state(in.subspan(Biquad::kStateSize, Biquad::kStateSize));
 }
 
 }  // namespace selfsense::control

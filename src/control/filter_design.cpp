@@ -106,4 +106,12 @@ BiquadCoefficients low_pass(const FirstOrderDesign& design, double sample_time) 
   return bilinear(analog, sample_time, design.frequency);
 }
 
+BiquadCoefficients high_pass(const FirstOrderDesign& design, double sample_time) {
+  std::string why;
+  require_valid(design.is_valid(sample_time, &why), why);
+  const double w0 = omega(design.frequency);
+  const AnalogBiquad analog{0.0, 1.0, 0.0, 0.0, 1.0, w0};
+  return bilinear(analog, sample_time, design.frequency);
+}
+
 }  // namespace selfsense::control

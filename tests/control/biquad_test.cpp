@@ -50,11 +50,12 @@ TEST(Biquad, NotchDepthAtItsFrequencyAndUnityFarAway) {
 }
 
 TEST(Biquad, SimulatedResponseMatchesTheAnalyticOneAtSeveralFrequencies) {
-  const std::array<BiquadCoefficients, 4> designs = {
+  const std::array<BiquadCoefficients, 5> designs = {
       notch({.frequency = 1000.0, .bandwidth = 200.0, .depth_db = 20.0}, kTs),
       low_pass(SecondOrderDesign{.frequency = 2000.0}, kTs),
       high_pass(SecondOrderDesign{.frequency = 200.0, .quality = 0.9}, kTs),
-      low_pass(FirstOrderDesign{.frequency = 800.0}, kTs)};
+      low_pass(FirstOrderDesign{.frequency = 800.0}, kTs),
+      high_pass(FirstOrderDesign{.frequency = 300.0}, kTs)};
   for (const BiquadCoefficients& c : designs) {
     for (const double f : {50.0, 200.0, 800.0, 1000.0, 2000.0, 5000.0}) {
       const double analytic = std::abs(c.response(f, kTs));

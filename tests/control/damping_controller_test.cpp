@@ -58,6 +58,36 @@ TEST(DampingController, VelocityFeedbackShortensTheRingDownFivefold) {
   EXPECT_LE(damped * 5.0, undamped) << "damped " << damped << " s, undamped " << undamped << " s";
 }
 
+TEST(DampingController, DcBlockKeepsPpfOffAStaticBias) {
+  // The mode is held at x = 1 by a constant drive of 1 (a biased actuator) and released from
+  // x = 1.5. PPF alone feeds the bias back too and moves the rest position to 1 / (1 - g) = 2;
+  // with a 20 Hz high-pass in front the rest position stays at 1 and the ring-down is as short.
+  const auto run = [](double dc_block_frequency, double* rest) {
+    DampingController ppf({.gain = 0.5,
+                           .frequency = kResonance,
+                           .damping = 0.3,
+                           .dc_block_frequency = dc_block_frequency},
+                          kTs);
+    ppf.reset(1.0);
+    test::ResonantPlant plant(kResonance, kPlantDamping, kTs);
+    plant.set_position(1.5);
+    std::vector<double> deviation(20000);
+    for (double& d : deviation) {
+      d = plant.position() - 1.0;
+      plant.advance(1.0 + ppf.step(plant.position()));
+    }
+    *rest = plant.position();
+    return test::settle_time(deviation, 0.025, kTs);
+  };
+  double rest_plain = 0.0;
+  double rest_blocked = 0.0;
+  run(0.0, &rest_plain);
+  const double ring_blocked = run(20.0, &rest_blocked);
+  EXPECT_NEAR(rest_plain, 2.0, 1e-3);
+  EXPECT_NEAR(rest_blocked, 1.0, 1e-3);
+  EXPECT_LE(ring_blocked * 5.0, ring_down(std::nullopt));
+}
+
 TEST(DampingController, PpfPassesDcWithItsGainAndVelocityFeedbackBlocksIt) {
   DampingController ppf({.gain = 0.5, .frequency = kResonance}, kTs);
   ppf.reset(2.0);
@@ -65,6 +95,10 @@ TEST(DampingController, PpfPassesDcWithItsGainAndVelocityFeedbackBlocksIt) {
   DampingController velocity({.law = Law::kVelocity, .gain = 1.0, .frequency = 2000.0}, kTs);
   velocity.reset(2.0);
   EXPECT_NEAR(velocity.step(2.0), 0.0, 1e-12);
+  DampingController blocked({.gain = 0.5, .frequency = kResonance, .dc_block_frequency = 10.0},
+                            kTs);
+  blocked.reset(2.0);
+  EXPECT_NEAR(blocked.step(2.0), 0.0, 1e-12);
   // A ramp gives -g * slope after the filter settles.
   for (int k = 0; k < 2000; ++k)
     velocity.step(3.0 * kTs * k);

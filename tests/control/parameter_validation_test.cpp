@@ -138,6 +138,10 @@ TEST(ParameterValidation, DampingController) {
             "DampingController.damping: 0 must be > 0");
   EXPECT_EQ(make({.gain = 1.0, .frequency = 100.0, .output_limit = 0.0}),
             "DampingController.output_limit: 0 must be > 0");
+  EXPECT_EQ(make({.gain = 1.0, .frequency = 100.0, .dc_block_frequency = -1.0}),
+            "DampingController.dc_block_frequency: -1 must be >= 0");
+  EXPECT_EQ(make({.gain = 1.0, .frequency = 100.0, .dc_block_frequency = 4500.0}),
+            "DampingController.dc_block_frequency: 4500 must be < 0.45 * sample rate = 4500");
 }
 
 TEST(ParameterValidation, IsValidCollectsWithoutThrowing) {

@@ -60,7 +60,8 @@ TEST(RealTime, StepsOfEveryControlLawDoNotAllocate) {
                      .table_values = {0.0, 1.0, 0.5, 0.0},
                      .table_times = {0.0, 0.01, 0.02, 0.05}},
                     kTs)};
-  DampingController ppf({.gain = 0.5, .frequency = 500.0, .damping = 0.3}, kTs);
+  DampingController ppf(
+      {.gain = 0.5, .frequency = 500.0, .damping = 0.3, .dc_block_frequency = 20.0}, kTs);
   DampingController velocity(
       {.law = DampingController::Law::kVelocity, .gain = 1e-4, .frequency = 5000.0}, kTs);
   std::array<double, 16> state{};

@@ -102,8 +102,10 @@ TEST(StateRoundTrip, WaveGeneratorEveryShape) {
 
 TEST(StateRoundTrip, DampingController) {
   using Law = DampingController::Law;
-  expect_round_trip(DampingController({.gain = 0.4, .frequency = 300.0, .damping = 0.3}, kTs),
-                    [](DampingController& d, std::size_t k) { return d.step(input(k)); });
+  expect_round_trip(
+      DampingController(
+          {.gain = 0.4, .frequency = 300.0, .damping = 0.3, .dc_block_frequency = 15.0}, kTs),
+      [](DampingController& d, std::size_t k) { return d.step(input(k)); });
   expect_round_trip(
       DampingController({.law = Law::kVelocity, .gain = 1e-4, .frequency = 2000.0}, kTs),
       [](DampingController& d, std::size_t k) { return d.step(input(k)); });

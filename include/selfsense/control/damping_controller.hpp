@@ -19,19 +19,24 @@
 // Velocity feedback: a band-limited derivative with negative sign,
 //   u = -g * s / (tau s + 1) * y,     g [u s/x] > 0,   tau = 1 / (2 pi fc)
 //
-// Both filters are discretised by the bilinear transform and run as one biquad in direct form
-// II transposed (see biquad.hpp). PPF is pre-warped at f_f, so its tuning is exact at the
-// resonance; the velocity filter is not (K = 2 / Ts), so its derivative gain is exact at low
-// frequency (a ramp of slope v gives u = -g v) and its corner lands at (2/Ts) atan(pi fc Ts):
-//   w[k]  = b0 y[k] + s1[k-1],   s1[k] = b1 y[k] - a1 w[k] + s2[k-1],   s2[k] = b2 y[k] - a2 w[k]
-//   u[k]  = clamp(sign * g * w[k], -u_limit, u_limit),   sign = +1 (PPF) or -1 (velocity)
-// PPF passes DC with gain g (it lowers the static stiffness a little); in a position loop feed it
-// the deviation from the setpoint, or put a high-pass in front.
+// PPF passes DC with gain g: on a signal with a static part (the self-sensed strain of a biased
+// actuator) set dc_block_frequency f_b > 0, which puts a first-order high-pass
+// s / (s + 2 pi f_b) in front of either law. Keep f_b well below the resonance (a tenth or
+// less): its phase lead at f_f detunes the PPF filter.
+//
+// Each filter is discretised by the bilinear transform and runs as a biquad in direct form II
+// transposed (see biquad.hpp). PPF and the high-pass are pre-warped at f_f and f_b, so they are
+// exact there; the velocity filter is not (K = 2 / Ts), so its derivative gain is exact at low
+// frequency (a ramp of slope v gives u = -g v) and its corner lands at (2 / Ts) atan(pi fc Ts)
+// [rad/s]. Per sample, with H_b the high-pass (identity when f_b = 0) and H the law's filter:
+//   y_b[k] = H_b(y)[k],   w[k] = H(y_b)[k]
+//   u[k]   = clamp(sign * g * w[k], -u_limit, u_limit),   sign = +1 (PPF) or -1 (velocity)
 //
 // Real-time safe: step(), reset(), save_state(), restore_state(). The constructor validates and
 // throws ParameterError naming the parameter.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -52,11 +57,12 @@ class DampingController final {
     double frequency{0.0};  // PPF: f_f [Hz], tuned to the resonance; velocity: corner fc [Hz]
     double damping{0.5};    // PPF: zeta_f > 0
     double output_limit{std::numeric_limits<double>::infinity()};  // u_limit [u] > 0
+    double dc_block_frequency{0.0};  // f_b [Hz] >= 0; 0 = no high-pass in front
 
     [[nodiscard]] bool is_valid(double sample_time, std::string* why) const;
   };
 
-  static constexpr std::size_t kStateSize = Biquad::kStateSize;
+  static constexpr std::size_t kStateSize = 2 * Biquad::kStateSize;
 
   // Throws ParameterError naming the parameter ("DampingController.frequency: ...").
   DampingController(const Params& params, double sample_time);
@@ -65,16 +71,20 @@ class DampingController final {
   // The filter without gain and sign.
   [[nodiscard]] const BiquadCoefficients& filter() const noexcept { return filter_.coefficients(); }
 
-  double step(double measurement) noexcept;
+  double step(double measurement) noexcept {
+    return std::clamp(signed_gain_ * filter_.step(dc_block_.step(measurement)),
+                      -params_.output_limit, params_.output_limit);
+  }
   // Steady state for a constant measurement y (no transient at arm).
-  void reset(double measurement = 0.0) noexcept { filter_.reset(measurement); }
+  void reset(double measurement = 0.0) noexcept;
 
   [[nodiscard]] static constexpr std::size_t state_size() noexcept { return kStateSize; }
-  void save_state(std::span<double> out) const noexcept { filter_.save_state(out); }
-  void restore_state(std::span<const double> in) noexcept { filter_.restore_state(in); }
+  void save_state(std::span<double> out) const noexcept;
+  void restore_state(std::span<const double> in) noexcept;
 
  private:
   Params params_{};
+  Biquad dc_block_{};  // pass-through when dc_block_frequency is 0
   Biquad filter_{};
   double signed_gain_{0.0};
 };

@@ -11,7 +11,7 @@
 //               Q = f0 / bandwidth, the bandwidth being the -3 dB width of an infinitely deep notch
 //   low-pass    w0^2 / (s^2 + (w0 / Q) s + w0^2),  Q = 1/sqrt(2) is the 2nd-order Butterworth
 //   high-pass   s^2  / (s^2 + (w0 / Q) s + w0^2)
-//   1st order   w0 / (s + w0)   (b2 = a2 = 0)
+//   1st order   w0 / (s + w0) low-pass, s / (s + w0) high-pass   (b2 = a2 = 0)
 //
 // Every corner or centre frequency must be below 0.45 times the sample rate (the warping grows
 // without bound towards Nyquist); violations throw ParameterError naming the parameter:
@@ -75,5 +75,6 @@ struct FirstOrderDesign {
 [[nodiscard]] BiquadCoefficients low_pass(const SecondOrderDesign& design, double sample_time);
 [[nodiscard]] BiquadCoefficients high_pass(const SecondOrderDesign& design, double sample_time);
 [[nodiscard]] BiquadCoefficients low_pass(const FirstOrderDesign& design, double sample_time);
+[[nodiscard]] BiquadCoefficients high_pass(const FirstOrderDesign& design, double sample_time);
 
 }  // namespace selfsense::control
