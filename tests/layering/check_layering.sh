@@ -21,6 +21,7 @@ declare -A allowed=(
   [model_io]="model_io models operators io"
   [plant_io]="plant_io plant io"
   [runtime]="runtime models operators control"
+  [daemon]="daemon runtime models operators control io model_io"
 )
 # The math: no files, streams, threads, clocks, sockets or file formats.
 math="operators models control plant identification"
@@ -57,7 +58,7 @@ done
 # Every library folder must be known here, so a new one cannot slip past the check.
 for dir in src/*/; do
   lib=$(basename "$dir")
-  case "$lib" in cli | daemon) continue ;; esac
+  [ "$lib" = cli ] && continue
   [ -n "${allowed[$lib]+x}" ] || report "src/$lib: library folder not in tests/layering/check_layering.sh"
 done
 
