@@ -380,23 +380,24 @@ OperatorBasis basis_for(const OperatorSignals& signals, const OperatorStructure&
 
 // Remanent state: the candidate history that best explains the first part of `signals` with
 // the operator `basis` (linear stage, S = identity); the two best grid candidates are refined
-// (rising and falling starts can be close).
+// (rising and falling starts can be close). creep_lags: score with the creep lags of the
+// linear term, or with the plays alone.
 std::vector<double> estimate_history(const OperatorSignals& signals, const OperatorBasis& basis,
-                                     double weight_floor, bool offset) {
+                                     double weight_floor, bool offset, bool creep_lags) {
   const std::size_t n = signals.input.size();
   const auto [x_lo, x_hi] = std::minmax_element(signals.input.begin(), signals.input.end());
   // The start state matters until the input has swept its whole range (wiping-out), so
   // twice that span decides between candidates.
   const std::size_t sweep = std::min(n, sweep_length(signals.input));
   const std::size_t head = std::min(n, std::max<std::size_t>(2 * sweep, 2000));
-  // Scored with the plays and the creep lags of the linear term only: the other creep
-  // columns cost most of the normal equations and say little about where the plays started,
-  // but without any creep the early creep transient is blamed on the plays and the wrong
-  // start wins (docs/identification.md). After the sweep every candidate's plays are wiped to
-  // the same state, so the rows of [sweep, head) are accumulated once; the lags still
-  // remember the start there, which the shared rows ignore (it only blurs the score).
+  // The other creep columns cost most of the normal equations and say little about where the
+  // plays started. After the sweep every candidate's plays are wiped to the same state, so the
+  // rows of [sweep, head) are accumulated once; the lags still remember the start there, which
+  // the shared rows ignore (it only blurs the score).
   OperatorBasis scoring = basis;
-  if (scoring.creep_rows.size() > 1) {
+  if (!creep_lags) {
+    scoring.creep_rows.clear();
+  } else if (scoring.creep_rows.size() > 1) {
     scoring.creep_rows.erase(scoring.creep_rows.begin() + 1, scoring.creep_rows.end());
   }
   const Fitter scorer(signals, scoring, weight_floor, offset);
@@ -484,8 +485,25 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
 
   const bool search = structure.estimate_history && structure.plays > 0;
   std::vector<double> history{signals.input.front()};
-  if (search) history = estimate_history(signals, basis, weight_floor, structure.fit_offset);
+  if (search) {
+    history = estimate_history(signals, basis, weight_floor, structure.fit_offset, true);
+  }
   Fit fit = fit_with_history(fitter, history, structure, n);
+  if (search && basis.creep() > 0) {
+    // Scored with the plays alone, the early creep transient is blamed on the plays and the
+    // wrong start can win (2x the least-squares error on a new recording); scored with the
+    // linear creep lags, a side whose creep sits on the plays can lose a little. Both are
+    // proxies on the first part of the data: the full fit decides.
+    std::vector<double> plays_only =
+        estimate_history(signals, basis, weight_floor, structure.fit_offset, false);
+    if (plays_only != history) {
+      Fit refit = fit_with_history(fitter, plays_only, structure, n);
+      if (refit.rss < fit.rss) {
+        fit = std::move(refit);
+        history = std::move(plays_only);
+      }
+    }
+  }
   if (search && structure.dead_zones > 0 && DeadZoneSuperposition(fit.shape).size() > 0) {
     // The first search scored the start with S = identity; when the data need dead zones its
     // model error outweighs the start's signature and a richer basis could pick a worse start
@@ -493,7 +511,7 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
     // operator is linear, and keep the better fit.
     const std::vector<double> v = inner_output(signals, fit);
     const OperatorSignals inner{signals.input, {}, v, signals.sample_time};
-    std::vector<double> second = estimate_history(inner, basis, weight_floor, true);
+    std::vector<double> second = estimate_history(inner, basis, weight_floor, true, true);
     if (second != history) {
       Fit refit = fit_with_history(fitter, second, structure, n);
       if (refit.rss < fit.rss) {
