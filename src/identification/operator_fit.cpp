@@ -487,23 +487,25 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
   std::vector<double> history{signals.input.front()};
   if (search) {
     history = estimate_history(signals, basis, weight_floor, structure.fit_offset, true);
-  }
-  Fit fit = fit_with_history(fitter, history, structure, n);
-  if (search && basis.creep() > 0) {
-    // Scored with the plays alone, the early creep transient is blamed on the plays and the
-    // wrong start can win (2x the least-squares error on a new recording); scored with the
-    // linear creep lags, a side whose creep sits on the plays can lose a little. Both are
-    // proxies on the first part of the data: the full fit decides.
-    std::vector<double> plays_only =
-        estimate_history(signals, basis, weight_floor, structure.fit_offset, false);
-    if (plays_only != history) {
-      Fit refit = fit_with_history(fitter, plays_only, structure, n);
-      if (refit.rss < fit.rss) {
-        fit = std::move(refit);
-        history = std::move(plays_only);
+    if (basis.creep() > 0) {
+      // Scored with the plays alone, the early creep transient is blamed on the plays and the
+      // wrong start can win (2x the least-squares error on a new recording); scored with the
+      // linear creep lags, a side whose creep sits on the plays can lose a little. Both are
+      // proxies: when they disagree, the whole basis decides on the first part of the data
+      // (where the start shows), at a fraction of the cost of a second full fit.
+      std::vector<double> plays_only =
+          estimate_history(signals, basis, weight_floor, structure.fit_offset, false);
+      if (plays_only != history) {
+        const std::size_t head =
+            std::min(n, std::max<std::size_t>(2 * sweep_length(signals.input), 2000));
+        const auto head_rss = [&](const std::vector<double>& h) {
+          return fitter.solve_linear(fitter.linear_gram(h, 0, head)).rss;
+        };
+        if (head_rss(plays_only) < head_rss(history)) history = std::move(plays_only);
       }
     }
   }
+  Fit fit = fit_with_history(fitter, history, structure, n);
   if (search && structure.dead_zones > 0 && DeadZoneSuperposition(fit.shape).size() > 0) {
     // The first search scored the start with S = identity; when the data need dead zones its
     // model error outweighs the start's signature and a richer basis could pick a worse start
