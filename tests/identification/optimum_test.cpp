@@ -11,6 +11,7 @@
 
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/identification/regressors.hpp"
+#include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/models/reconstructor.hpp"
 #include "selfsense/operators/linear_creep.hpp"
 #include "support/operator_recordings.hpp"
@@ -157,15 +158,15 @@ Series run_reference(const Reference& ref, const test::OperatorRecording& r) {
 models::TransducerModel library_fit(const test::OperatorRecording& r, std::size_t plays,
                                     std::size_t dead_zones, std::size_t eigenvalues,
                                     std::size_t creep_plays, std::size_t fit_to) {
-  models::IdentificationOptions o;
+  identification::IdentificationOptions o;
   o.plays = plays;
   o.dead_zones = dead_zones;
   o.eigenvalues = eigenvalues;
   o.creep_plays = creep_plays;
-  const models::TransducerSignals s{std::span(r.e).first(fit_to), std::span(r.d).first(fit_to),
+  const identification::TransducerSignals s{std::span(r.e).first(fit_to), std::span(r.d).first(fit_to),
                                     std::span(r.t).first(fit_to), std::span(r.s).first(fit_to),
                                     kTs};
-  return models::identify(
+  return identification::identify(
       s, eigenvalues > 0 ? models::Structure::kHysteresisCreep : models::Structure::kHysteresis, o);
 }
 
