@@ -83,10 +83,19 @@ unmount_all() {
   done
   return 0
 }
-trap unmount_all EXIT
-unmount_all
-rm -rf "$build"
-mkdir -p "$build"
+# shellcheck disable=SC2317 # called by the EXIT trap
+cleanup() {
+  unmount_all
+  mountpoint -q "$root" 2>/dev/null && umount -l "$root"
+  return 0
+}
+trap cleanup EXIT
+cleanup
+rm -rf --one-file-system "$build"
+mkdir -p "$root"
+# The root is built in memory: dpkg's many fsyncs cost minutes on a busy disk and nothing of
+# the root is kept but the ext4 image made from it.
+mount -t tmpfs -o size=4g,mode=0755 selfsense-vm-root "$root"
 
 step "debootstrap --variant=minbase $suite from $mirror"
 debootstrap --variant=minbase "$suite" "$root" "$mirror" >"$build/debootstrap.log" 2>&1 ||
@@ -169,8 +178,10 @@ cp -L "$root/initrd.img" "$build/initrd.img"
 
 step "mke2fs root.img"
 size_mib=$(($(du -sm "$root" | cut -f1) * 3 / 2 + 512))
-mke2fs -q -t ext4 -L root -d "$root" "$build/root.img" "${size_mib}M"
-rm -rf --one-file-system "$root"
+# mke2fs names the file it creates on stdout, which is reserved for the image directory.
+mke2fs -q -t ext4 -L root -d "$root" "$build/root.img" "${size_mib}M" >&2
+umount "$root"
+rmdir "$root"
 vm_packages >"$build/packages"
 touch "$build/ready"
 

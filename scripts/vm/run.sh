@@ -40,7 +40,7 @@ trap cleanup EXIT
 
 # Room for what the payload brings and what it writes under out/.
 size_mib=$(($(du -sm "$payload" | cut -f1) * 2 + 64))
-mke2fs -q -t ext4 -L payload -d "$payload" "$work/payload.img" "${size_mib}M"
+mke2fs -q -t ext4 -L payload -d "$payload" "$work/payload.img" "${size_mib}M" >/dev/null
 
 # quiet and loglevel=3 keep the console to the payload's lines and real errors; panic=-1 with
 # -no-reboot turns a kernel panic into qemu exiting at once instead of a hang.
