@@ -7,8 +7,8 @@
 # PAYLOAD_DIR/run.sh runs as root under systemd once the system is up, with /payload as its
 # working directory and its output on the serial console. Lines it prints starting with
 # "SELFSENSE-VM:" are the results, shown here; the whole console goes to $SELFSENSE_VM_LOG
-# (default: a fresh file under /tmp, named at the end). Files the payload writes under
-# /payload/out are copied back to $SELFSENSE_VM_OUT when that is set.
+# (default: a fresh file under /tmp, named at the end). When $SELFSENSE_VM_OUT is set, what the
+# payload left under /payload/out is copied back to $SELFSENSE_VM_OUT/out.
 #
 # Exit status: the payload's; 124 when the VM ran out of time (TIMEOUT_S, default 300);
 # 125 when it stopped without reporting one (kernel panic, boot failure); 77 when the image
@@ -50,8 +50,9 @@ append+=" ${SELFSENSE_VM_APPEND:-}"
 vm_say "run: booting $image with payload $payload (timeout ${timeout_s} s)"
 start=$SECONDS
 status=0
-# -snapshot keeps the cached root unchanged; -cpu max lets host-built programs use the
-# instructions the host has. No network: the payload brings everything it needs.
+# snapshot=on keeps the cached root unchanged (writes go to a temporary file); -cpu max lets
+# host-built programs use the instructions the host has. -nodefaults: no network, VGA,
+# floppy or CD-ROM to probe; the payload brings everything it needs.
 timeout --kill-after=10 "$timeout_s" qemu-system-x86_64 \
   -m 1024 -smp 2 -cpu max -nographic -no-reboot -nodefaults -serial stdio \
   -kernel "$image/vmlinuz" -initrd "$image/initrd.img" -append "$append" \
@@ -66,8 +67,10 @@ results=$(tr -d '\r' <"$log" | grep -ao 'SELFSENSE-VM: .*' || true)
 
 if [ -n "${SELFSENSE_VM_OUT:-}" ]; then
   mkdir -p "$SELFSENSE_VM_OUT"
-  debugfs -R "rdump /out $SELFSENSE_VM_OUT" "$work/payload.img" >/dev/null 2>&1 ||
-    vm_say "run: the payload wrote nothing under /payload/out"
+  rm -rf "${SELFSENSE_VM_OUT:?}/out"
+  # debugfs reads the ext4 image without mounting it; it exits 0 even when /out is missing.
+  debugfs -R "rdump /out $SELFSENSE_VM_OUT" "$work/payload.img" >/dev/null 2>&1 || true
+  [ -d "$SELFSENSE_VM_OUT/out" ] || vm_say "run: the payload left no /payload/out"
 fi
 
 exit_line=$(printf '%s\n' "$results" | grep -E '^SELFSENSE-VM: EXIT [0-9]+$' | tail -1 || true)

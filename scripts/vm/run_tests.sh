@@ -41,7 +41,7 @@ done
 [ ${#programs[@]} -eq 0 ] || "$vm_scripts/add_program.sh" "$out/payload" "${programs[@]}"
 
 status=0
-SELFSENSE_VM_LOG="$out/console.log" SELFSENSE_VM_OUT="$out/out" \
+SELFSENSE_VM_LOG="$out/console.log" SELFSENSE_VM_OUT="$out" \
   "$vm_scripts/run.sh" "$out/payload" "$timeout_s" >"$out/results.txt" || status=$?
 echo "$status" >"$out/status"
 cat "$out/results.txt"
