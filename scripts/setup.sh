@@ -88,6 +88,16 @@ run_self_sensing() {
     --out "$out/reconstructed.csv"
 }
 
+# The tests under a real kernel and systemd (tests/vm, docs/vm-testing.md): builds the cached
+# VM image unless present (as root; a few minutes once, then instant), then boots it once for
+# every VM test. Needs a configured build directory (the tests are CTest tests).
+run_vm_tests() {
+  local dir=${1:-build}
+  say "vm: image (cached under /var/cache/selfsense-vm)"
+  scripts/vm/image.sh >/dev/null
+  run_tests "$dir" -L vm
+}
+
 install_missing
 case "$mode" in
   demo)
