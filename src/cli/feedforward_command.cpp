@@ -14,7 +14,7 @@
 #include "commands.hpp"
 #include "field_signals.hpp"
 #include "selfsense/io/recording.hpp"
-#include "selfsense/models/model_yaml.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/operators/hysteresis_creep.hpp"
 #include "selfsense/operators/parameter_error.hpp"
 

@@ -17,9 +17,10 @@
 #include "commands.hpp"
 #include "field_signals.hpp"
 #include "model_runs.hpp"
+#include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/io/yaml_map.hpp"
-#include "selfsense/models/model_yaml.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
 
 namespace selfsense::cli {
 namespace {
@@ -89,7 +90,7 @@ void run_identify(const IdentifyOptions& opt) {
   if (split < 2)
     throw std::invalid_argument("--holdout or --fit-until leave fewer than 2 samples to fit");
 
-  models::IdentificationOptions sizes = models::defaults_for(*structure);
+  identification::IdentificationOptions sizes = identification::defaults_for(*structure);
   if (opt.plays >= 0) sizes.plays = static_cast<std::size_t>(opt.plays);
   if (opt.eigenvalues >= 0) sizes.eigenvalues = static_cast<std::size_t>(opt.eigenvalues);
   if (opt.creep_plays >= 0) sizes.creep_plays = static_cast<std::size_t>(opt.creep_plays);
@@ -101,9 +102,9 @@ void run_identify(const IdentifyOptions& opt) {
     return v.empty() ? std::span<const double>{} : std::span<const double>(v).first(split);
   };
   const auto sensed = signals.sensed(drive);
-  const models::TransducerSignals part{signals.drive(drive).first(split),
-                                       sensed.empty() ? sensed : sensed.first(split),
-                                       head(signals.stress), head(signals.s), signals.sample_time};
+  const identification::TransducerSignals part{
+      signals.drive(drive).first(split), sensed.empty() ? sensed : sensed.first(split),
+      head(signals.stress), head(signals.s), signals.sample_time};
   if (sensed.empty())
     std::printf("note: %s has no sensed channel: actuator side only\n", signals.source.c_str());
   if (signals.stress.empty()) {
@@ -111,7 +112,7 @@ void run_identify(const IdentifyOptions& opt) {
                 signals.source.c_str());
   }
   const auto start = std::chrono::steady_clock::now();
-  models::TransducerModel model = models::identify(part, *structure, sizes);
+  models::TransducerModel model = identification::identify(part, *structure, sizes);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   model.geometry = geometry;
@@ -133,7 +134,12 @@ void run_identify(const IdentifyOptions& opt) {
                            {"seconds", seconds},
                            {"fit", to_json(fit)},
                            {"held_out", to_json(held)}};
-  if (runs.solver_failures > 0) report["solver_failures"] = runs.solver_failures;
+  if (!runs.estimate_status.empty()) {
+    report["estimate_status"] = to_json(runs.estimate_counts);
+    if (runs.estimate_counts.not_ok() > 0) {
+      std::printf("reconstruction status: %s\n", describe(runs.estimate_counts).c_str());
+    }
+  }
   // Couplings exist only when the recording had a stress channel.
   if (model.sensor && !model.sensor->linear_gains.empty()) {
     report["sensor_coupling"] = model.sensor->linear_gains.front();
@@ -147,14 +153,14 @@ void run_identify(const IdentifyOptions& opt) {
   if (!opt.validate.empty()) {
     const io::Recording vrec = io::read_recording_csv(opt.validate, io::ReadOptions{{"t"}});
     const FieldSignals vsig = field_signals(vrec, opt.validate.string(), geometry, drive);
-    if (std::abs(vsig.sample_time - signals.sample_time) > 0.01 * signals.sample_time) {
-      throw io::RecordingError(opt.validate.string() +
-                               ": sample time differs from the recording's");
-    }
-    const std::vector<ChannelFigures> val =
-        figures(model, vsig, run_model(model, vsig, true, true), 0, vsig.size());
-    std::printf("validation on %s (%zu samples):\n", vsig.source.c_str(), vsig.size());
+    const ModelRuns vruns = run_model(model, vsig, true, true);
+    const std::vector<ChannelFigures> val = figures(model, vsig, vruns, 0, vsig.size());
+    std::printf("validation on %s (%zu samples%s):\n", vsig.source.c_str(), vsig.size(),
+                vruns.rediscretised ? ", model re-discretised for its sample time" : "");
     print_table(val, {});
+    if (vruns.estimate_counts.not_ok() > 0) {
+      std::printf("reconstruction status: %s\n", describe(vruns.estimate_counts).c_str());
+    }
     report["validation"] = to_json(val);
   }
   if (!opt.json.empty()) {

@@ -1,89 +1,77 @@
 #include "model_runs.hpp"
 
 #include <cstdio>
-#include <optional>
 #include <span>
-
-#include "selfsense/models/reconstructor.hpp"
-#include "selfsense/models/stress_hysteresis.hpp"
 
 namespace selfsense::cli {
 
-namespace {
-
-// The stress-dependent model: forward from E and T, numerical reconstruction from E and D.
-ModelRuns run_vectorial(const models::StressHysteresisModel& m, const FieldSignals& signals,
-                        bool forward, bool reconstruct) {
-  const std::size_t n = signals.size();
-  ModelRuns runs;
-  if (forward) {
-    models::StressHysteresisForward f(m);
-    if (m.sensor) runs.sensed.resize(n);
-    if (m.actuator) runs.strain.resize(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      const double stress = signals.stress.empty() ? 0.0 : signals.stress[k];
-      const models::StressHysteresisForward::Output out = f.step(signals.e[k], stress);
-      if (m.sensor) runs.sensed[k] = out.sensed;
-      if (m.actuator) runs.strain[k] = out.strain;
-    }
-  }
-  if (reconstruct && m.sensor && !signals.d.empty()) {
-    models::StressHysteresisReconstructor r(m);
-    runs.stress_hat.resize(n);
-    if (m.actuator) runs.strain_hat.resize(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      const models::StressHysteresisReconstructor::Estimate est =
-          r.step(signals.e[k], signals.d[k]);
-      runs.stress_hat[k] = est.stress;
-      if (m.actuator) runs.strain_hat[k] = est.strain;
-    }
-    const auto& c = r.status_counts();
-    runs.solver_failures = n - c[static_cast<std::size_t>(models::SolveStatus::kOk)];
-    if (runs.solver_failures > 0) {
-      static_cast<void>(std::fprintf(
-          stderr,
-          "warning: stress not uniquely reconstructed at %zu of %zu samples (no solution "
-          "%zu, D-T not monotone %zu, not converged %zu)\n",
-          runs.solver_failures, n, c[1], c[2], c[3]));
-    }
-  }
-  return runs;
-}
-
-}  // namespace
-
 ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& signals, bool forward,
                     bool reconstruct) {
-  if (model.vectorial) return run_vectorial(*model.vectorial, signals, forward, reconstruct);
   const models::Drive drive = model.drive();
   const std::span<const double> x = signals.drive(drive);
   const std::span<const double> y = signals.sensed(drive);
   const std::size_t n = signals.size();
+  const models::RuntimeOptions options{signals.sample_time};
   ModelRuns runs;
+  runs.sample_time = signals.sample_time;
   if (forward) {
-    models::ForwardModel f(model);
-    if (model.sensor) runs.sensed.resize(n);
-    if (model.actuator) runs.strain.resize(n);
+    models::Simulation sim(model, options);
+    runs.rediscretised = sim.rediscretised();
+    const bool sensor = model.sensor || (model.vectorial && model.vectorial->sensor);
+    const bool actuator = model.actuator || (model.vectorial && model.vectorial->actuator);
+    if (sensor) runs.sensed.resize(n);
+    if (actuator) runs.strain.resize(n);
+    runs.forward_status.resize(n);
     for (std::size_t k = 0; k < n; ++k) {
       const double stress = signals.stress.empty() ? 0.0 : signals.stress[k];
-      const models::ForwardModel::Output out = f.step(x[k], stress);
-      if (model.sensor) runs.sensed[k] = out.sensed;
-      if (model.actuator) runs.strain[k] = out.strain;
+      const models::Simulation::Output out = sim.step(x[k], stress);
+      if (sensor) runs.sensed[k] = out.sensed;
+      if (actuator) runs.strain[k] = out.strain;
+      runs.forward_status[k] = static_cast<double>(out.status);
     }
+    runs.forward_counts = sim.counts();
   }
-  const bool coupled = model.sensor && !model.sensor->linear_gains.empty() &&
-                       model.sensor->linear_gains.front() != 0.0;
-  if (reconstruct && coupled && !y.empty()) {
-    models::Reconstructor r(model);
+  if (reconstruct && can_reconstruct(model) && !y.empty()) {
+    models::Reconstruction rec(model, options);
+    runs.rediscretised = rec.rediscretised();
     runs.stress_hat.resize(n);
-    if (model.actuator) runs.strain_hat.resize(n);
+    if (rec.has_strain()) runs.strain_hat.resize(n);
+    runs.estimate_status.resize(n);
     for (std::size_t k = 0; k < n; ++k) {
-      const models::Reconstructor::Estimate est = r.step(x[k], y[k]);
+      const models::Reconstruction::Estimate est = rec.step(x[k], y[k]);
       runs.stress_hat[k] = est.stress;
-      if (model.actuator) runs.strain_hat[k] = est.strain;
+      if (rec.has_strain()) runs.strain_hat[k] = est.strain;
+      runs.estimate_status[k] = static_cast<double>(est.status);
     }
+    runs.estimate_counts = rec.counts();
   }
   return runs;
+}
+
+bool can_reconstruct(const models::TransducerModel& model) {
+  if (model.vectorial) return model.vectorial->sensor.has_value();
+  return model.sensor && !model.sensor->linear_gains.empty() &&
+         model.sensor->linear_gains.front() != 0.0;
+}
+
+std::string describe(const models::StatusCounts& counts) {
+  std::string out;
+  for (std::size_t i = 0; i < models::kSampleStatusCount; ++i) {
+    const auto s = static_cast<models::SampleStatus>(i);
+    if (counts[s] == 0) continue;
+    if (!out.empty()) out += ", ";
+    out += std::string(models::to_string(s)) + " " + std::to_string(counts[s]);
+  }
+  return out.empty() ? "no samples" : out;
+}
+
+nlohmann::json to_json(const models::StatusCounts& counts) {
+  nlohmann::json out = nlohmann::json::object();
+  for (std::size_t i = 0; i < models::kSampleStatusCount; ++i) {
+    const auto s = static_cast<models::SampleStatus>(i);
+    out[std::string(models::to_string(s))] = counts[s];
+  }
+  return out;
 }
 
 std::vector<ChannelFigures> figures(const models::TransducerModel& model,

@@ -1,5 +1,6 @@
-// Runs a transducer model over a whole recording (forward and reconstruction) and computes the
-// fit figures of contracts.md per channel.
+// Runs a transducer model over a whole recording (forward and reconstruction, through the
+// runtime model types at the recording's sample rate) and computes the fit figures of
+// contracts.md per channel.
 #pragma once
 
 #include <cstddef>
@@ -9,6 +10,7 @@
 
 #include "field_signals.hpp"
 #include "selfsense/identification/fit_quality.hpp"
+#include "selfsense/models/runtime_model.hpp"
 #include "selfsense/models/transducer_model.hpp"
 
 namespace selfsense::cli {
@@ -18,13 +20,23 @@ struct ModelRuns {
   std::vector<double> strain{};  // S_model
   std::vector<double> stress_hat{};
   std::vector<double> strain_hat{};
-  std::size_t solver_failures{0};  // numerical reconstruction: samples without a unique T
+  std::vector<double> forward_status{};   // models::SampleStatus codes per sample
+  std::vector<double> estimate_status{};  // of the reconstruction
+  models::StatusCounts forward_counts{};
+  models::StatusCounts estimate_counts{};
+  double sample_time{0.0};    // [s] the model ran at (the recording's)
+  bool rediscretised{false};  // the model was identified at another sample time
 };
 
 // Forward with the recorded stress (0 where the recording has none); reconstruction where the
 // model has a sensor side with a coupling and the recording the sensed channel.
 [[nodiscard]] ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& signals,
                                   bool forward, bool reconstruct);
+// A sensor side with a stress coupling (or the stress-dependent model's sensor side).
+[[nodiscard]] bool can_reconstruct(const models::TransducerModel& model);
+// "ok 148199, input_out_of_range 1"
+[[nodiscard]] std::string describe(const models::StatusCounts& counts);
+[[nodiscard]] nlohmann::json to_json(const models::StatusCounts& counts);
 
 struct ChannelFigures {
   std::string channel{};  // D (or E), S, T_hat, S_hat

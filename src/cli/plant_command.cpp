@@ -19,7 +19,7 @@
 #include "selfsense/io/recording.hpp"
 #include "selfsense/plant/excitation.hpp"
 #include "selfsense/plant/plant.hpp"
-#include "selfsense/plant/plant_yaml.hpp"
+#include "selfsense/plant_io/plant_yaml.hpp"
 #include "selfsense/runtime/pacer.hpp"
 
 namespace selfsense::cli {

@@ -10,7 +10,7 @@
 #include "field_signals.hpp"
 #include "model_runs.hpp"
 #include "selfsense/io/recording.hpp"
-#include "selfsense/models/model_yaml.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/operators/parameter_error.hpp"
 
 namespace selfsense::cli {
@@ -22,13 +22,13 @@ struct RunOptions {
   std::filesystem::path out{};
 };
 
-// The model's creep is discretised for its sample time: the recording must match it.
-void check_sample_time(const models::TransducerModel& model, const FieldSignals& signals) {
-  if (std::abs(signals.sample_time - model.sample_time) > 0.01 * model.sample_time) {
-    throw io::RecordingError(
-        signals.source + ": sample time " + operators::format_number(signals.sample_time) +
-        " s differs from the model's " + operators::format_number(model.sample_time) + " s");
+// Says what a user must know about the run: the rate it ran at and every rejected sample.
+void report(const ModelRuns& runs, const models::StatusCounts& counts) {
+  if (runs.rediscretised) {
+    std::printf("model re-discretised for the recording's sample time %s s\n",
+                operators::format_number(runs.sample_time).c_str());
   }
+  std::printf("samples: %s\n", describe(counts).c_str());
 }
 
 void run(const RunOptions& opt, bool reconstruct) {
@@ -36,20 +36,28 @@ void run(const RunOptions& opt, bool reconstruct) {
   io::Recording rec = io::read_recording_csv(opt.recording, io::ReadOptions{{"t"}});
   const FieldSignals signals =
       field_signals(rec, opt.recording.string(), model.geometry, model.drive());
-  check_sample_time(model, signals);
   if (reconstruct) {
     if (signals.sensed(model.drive()).empty()) {
       throw io::RecordingError(signals.source + ": reconstruction needs the sensed channel (" +
                                (model.drive() == models::Drive::kField ? "D or q)" : "E or u)"));
     }
+    if (!can_reconstruct(model)) {
+      throw io::RecordingError(opt.model.string() +
+                               ": the model cannot reconstruct stress (no sensor side with a "
+                               "stress coupling: identify it from a recording with T or F)");
+    }
     const ModelRuns runs = run_model(model, signals, false, true);
     rec.set_column("T_hat", runs.stress_hat);
     if (!runs.strain_hat.empty()) rec.set_column("S_hat", runs.strain_hat);
+    rec.set_column("estimate_status", runs.estimate_status);
+    report(runs, runs.estimate_counts);
   } else {
     const ModelRuns runs = run_model(model, signals, true, false);
     const bool field = model.drive() == models::Drive::kField;
     if (!runs.sensed.empty()) rec.set_column(field ? "D_model" : "E_model", runs.sensed);
     if (!runs.strain.empty()) rec.set_column("S_model", runs.strain);
+    rec.set_column("model_status", runs.forward_status);
+    report(runs, runs.forward_counts);
   }
   rec.comments.push_back(std::string("selfsense ") + (reconstruct ? "reconstruct" : "simulate") +
                          " with model " + opt.model.string());

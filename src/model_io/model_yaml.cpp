@@ -1,4 +1,4 @@
-#include "selfsense/models/model_yaml.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -104,6 +104,14 @@ StressHysteresisModel read_vectorial(YamlMap& root, double ts) {
   return m;
 }
 
+std::optional<InputRange> read_range(YamlMap& map, std::string_view key) {
+  if (!map.has(key)) return std::nullopt;
+  std::vector<double> range;
+  map.read_sequence(key, range);
+  if (range.size() != 2) map.fail(key, "expected [min, max]");
+  return InputRange{range[0], range[1]};
+}
+
 TransducerModel read_model(YamlMap root) {
   const int version = root.required<int>("selfsense_model");
   if (version != kModelFormatVersion) {
@@ -129,6 +137,11 @@ TransducerModel read_model(YamlMap root) {
     std::string why;
     if (!geo.is_valid(&why)) throw io::YamlError(root.locate(why));
     model.geometry = geo;
+  }
+  if (auto r = root.optional_map("input_range")) {
+    model.drive_range = read_range(*r, "drive");
+    model.sensed_range = read_range(*r, "sensed");
+    r->finish();
   }
   if (model.structure == Structure::kStressHysteresis) {
     model.vectorial = read_vectorial(root, model.sample_time);
@@ -224,6 +237,16 @@ std::string model_to_string(const TransducerModel& model, const std::string& fit
     out << YAML::Key << "layers" << YAML::Value << g.layers;
     out << YAML::Key << "active_length_m" << YAML::Value << g.active_length;
     out << YAML::Key << "cross_section_m2" << YAML::Value << g.cross_section;
+    out << YAML::EndMap;
+  }
+  if (model.drive_range || model.sensed_range) {
+    out << YAML::Key << "input_range" << YAML::Value << YAML::BeginMap;
+    if (model.drive_range) {
+      emit_sequence(out, "drive", {model.drive_range->min, model.drive_range->max});
+    }
+    if (model.sensed_range) {
+      emit_sequence(out, "sensed", {model.sensed_range->min, model.sensed_range->max});
+    }
     out << YAML::EndMap;
   }
   if (model.vectorial) emit_vectorial(out, *model.vectorial);

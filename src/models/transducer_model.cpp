@@ -1,6 +1,7 @@
 #include "selfsense/models/transducer_model.hpp"
 
 #include <array>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -37,16 +38,13 @@ bool side_valid(const char* name, const std::optional<SideModel>& side, double t
          operators::check::finite(std::string(name) + ".quadratic", side->quadratic, why);
 }
 
-identification::OperatorStructure structure_of(const IdentificationOptions& o, bool creep) {
-  identification::OperatorStructure s;
-  s.plays = o.plays;
-  s.eigenvalues = creep ? o.eigenvalues : 0;
-  s.creep_plays = creep ? o.creep_plays : 0;
-  s.dead_zones = o.dead_zones;
-  s.estimate_history = o.estimate_history;
-  s.fastest_eigenvalue = o.fastest_eigenvalue;
-  s.slowest_eigenvalue = o.slowest_eigenvalue;
-  return s;
+bool range_valid(const char* name, const std::optional<InputRange>& range, std::string* why) {
+  if (!range) return true;
+  if (std::isfinite(range->min) && std::isfinite(range->max) && range->max > range->min) {
+    return true;
+  }
+  if (why != nullptr) *why = std::string(name) + ": expected finite [min, max] with min < max";
+  return false;
 }
 
 }  // namespace
@@ -80,6 +78,10 @@ Drive drive_of(Structure s) noexcept {
 
 bool TransducerModel::is_valid(std::string* why) const {
   if (!operators::check::positive("sample_time", sample_time, why)) return false;
+  if (!range_valid("input_range.drive", drive_range, why) ||
+      !range_valid("input_range.sensed", sensed_range, why)) {
+    return false;
+  }
   if (structure == Structure::kStressHysteresis) {
     if (!vectorial || (!vectorial->sensor && !vectorial->actuator)) {
       if (why != nullptr) *why = "model: stress-hysteresis needs its vectorial section";
@@ -94,78 +96,6 @@ bool TransducerModel::is_valid(std::string* why) const {
   if (geometry && !geometry->is_valid(why)) return false;
   return side_valid("sensor", sensor, sample_time, why) &&
          side_valid("actuator", actuator, sample_time, why);
-}
-
-IdentificationOptions defaults_for(Structure s) noexcept {
-  switch (s) {
-    case Structure::kLinear:
-      return {};
-    case Structure::kPermittivity:
-      return {0, 0, 0, 8, false, 0.0, 0.0};
-    case Structure::kHysteresis:
-    case Structure::kChargeDrive:
-      return {24, 0, 0, 8, true, 0.0, 0.0};
-    case Structure::kHysteresisCreep:
-      return {24, 6, 2, 8, true, 0.0, 0.0};
-    case Structure::kStressHysteresis:
-      return {16, 0, 0, 0, false, 0.0, 0.0};
-  }
-  return {};
-}
-
-TransducerModel identify(const TransducerSignals& signals, Structure structure,
-                         const IdentificationOptions& options) {
-  const std::size_t n = signals.drive.size();
-  const auto usable = [n](std::span<const double> s) { return !s.empty() && s.size() == n; };
-  if (n < 2) throw std::invalid_argument("identify: the drive signal needs at least 2 samples");
-  if (!usable(signals.sensed) && !usable(signals.strain)) {
-    throw std::invalid_argument("identify: needs the sensed channel or the strain to fit");
-  }
-  if (!signals.stress.empty() && signals.stress.size() != n) {
-    throw std::invalid_argument("identify: stress and drive differ in length");
-  }
-  TransducerModel model;
-  model.structure = structure;
-  model.sample_time = signals.sample_time;
-  if (structure == Structure::kStressHysteresis) {
-    if (signals.stress.empty()) {
-      throw std::invalid_argument("identify: stress-hysteresis needs a stress channel (T or F)");
-    }
-    model.vectorial = fit_stress_hysteresis(signals.drive, signals.stress, signals.sensed,
-                                            signals.strain, signals.sample_time, options.plays);
-    return model;
-  }
-  std::vector<std::span<const double>> linear;
-  if (!signals.stress.empty()) linear.push_back(signals.stress);
-
-  const bool creep = structure == Structure::kHysteresisCreep;
-  if (usable(signals.sensed)) {
-    model.sensor = identification::fit_operator(
-        {signals.drive, linear, signals.sensed, signals.sample_time}, structure_of(options, creep));
-  }
-  if (usable(signals.strain)) {
-    // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19);
-    // with charge drive it also has the electrostrictive term S ~ D^2, which makes the
-    // butterfly strain loops of bipolar drive past the coercive field.
-    const bool linear_side =
-        structure == Structure::kPermittivity || structure == Structure::kChargeDrive;
-    std::vector<double> squared;
-    std::vector<std::span<const double>> inputs = linear;
-    if (structure == Structure::kChargeDrive) {
-      squared.resize(n);
-      for (std::size_t k = 0; k < n; ++k)
-        squared[k] = signals.drive[k] * signals.drive[k];
-      inputs.emplace_back(squared);
-    }
-    model.actuator = identification::fit_operator(
-        {signals.drive, inputs, signals.strain, signals.sample_time},
-        linear_side ? identification::OperatorStructure{} : structure_of(options, creep));
-    if (!squared.empty()) {
-      model.actuator->quadratic = model.actuator->linear_gains.back();
-      model.actuator->linear_gains.pop_back();
-    }
-  }
-  return model;
 }
 
 }  // namespace selfsense::models

@@ -7,10 +7,11 @@
 #include <vector>
 
 #include "selfsense/identification/fit_quality.hpp"
+#include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/models/reconstructor.hpp"
 #include "selfsense/operators/hysteresis_creep.hpp"
 #include "selfsense/plant/plant.hpp"
-#include "selfsense/plant/plant_yaml.hpp"
+#include "selfsense/plant_io/plant_yaml.hpp"
 
 namespace selfsense {
 namespace {
@@ -46,7 +47,8 @@ Recorded record_mix(std::uint64_t seed) {
 }
 
 models::TransducerModel identify(const Recorded& r, models::Structure structure) {
-  return models::identify({r.e, r.d, r.t, r.s, 1e-3}, structure, models::defaults_for(structure));
+  return identification::identify({r.e, r.d, r.t, r.s, 1e-3}, structure,
+                                  identification::defaults_for(structure));
 }
 
 struct Figures {

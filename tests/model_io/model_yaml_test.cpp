@@ -1,14 +1,17 @@
-#include "selfsense/models/model_yaml.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
+#include "selfsense/identification/stress_hysteresis_fit.hpp"
 #include "selfsense/io/yaml_map.hpp"
 #include "support/transducer_data.hpp"
 
 namespace selfsense::models {
 namespace {
+
+using identification::fit_stress_hysteresis;
 
 void expect_error(const std::string& text, const std::string& fragment) {
   try {

@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "selfsense/identification/stress_hysteresis_fit.hpp"
 #include "selfsense/models/reconstructor.hpp"
 #include "selfsense/models/stress_hysteresis.hpp"
 #include "support/allocation_counter.hpp"
@@ -12,6 +13,8 @@
 
 namespace selfsense::models {
 namespace {
+
+using identification::fit_stress_hysteresis;
 
 static_assert(noexcept(std::declval<Reconstructor&>().step(0.0, 0.0)));
 static_assert(noexcept(std::declval<ForwardModel&>().step(0.0, 0.0)));

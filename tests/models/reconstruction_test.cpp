@@ -4,11 +4,16 @@
 #include <vector>
 
 #include "selfsense/identification/fit_quality.hpp"
+#include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/models/reconstructor.hpp"
 #include "support/transducer_data.hpp"
 
 namespace selfsense::models {
 namespace {
+
+using identification::defaults_for;
+using identification::identify;
+using identification::TransducerSignals;
 
 using identification::fit_quality;
 

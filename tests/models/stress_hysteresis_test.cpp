@@ -7,12 +7,19 @@
 #include <vector>
 
 #include "selfsense/identification/fit_quality.hpp"
+#include "selfsense/identification/stress_hysteresis_fit.hpp"
+#include "selfsense/identification/transducer_fit.hpp"
+#include "selfsense/models/bracketed_solver.hpp"
 #include "selfsense/models/reconstructor.hpp"
 #include "selfsense/plant/plant.hpp"
 #include "support/stressed_stack.hpp"
 
 namespace selfsense::models {
 namespace {
+
+using identification::defaults_for;
+using identification::fit_stress_hysteresis;
+using identification::identify;
 
 using identification::fit_quality;
 
@@ -95,7 +102,54 @@ TEST(StressHysteresis, ReconstructsStressWhereTheAffineModelCannot) {
   EXPECT_LT(q_vec.nrmse, 0.015);
   EXPECT_LT(q_vec.nrmse, 0.2 * q_aff.nrmse);
   EXPECT_LT(q_s.nrmse, 0.01);
-  EXPECT_EQ(vectorial.status_counts()[static_cast<std::size_t>(SolveStatus::kOk)], r.e.size());
+  EXPECT_EQ(vectorial.status_counts()[SampleStatus::kOk], r.e.size());
+}
+
+// A model whose sensor side is D = a + b T + c T^2 with a = E (one linear play, weight 1) and
+// b, c given: the closed-form reconstruction against the exact answer.
+StressHysteresisModel quadratic_model(double b, double c, double lo, double hi) {
+  StressHysteresisModel m;
+  m.sample_time = 1e-3;
+  m.basis.thresholds = {0.0};
+  m.history = {0.0};
+  m.sensor = StressHysteresisSide{{1.0}, {0.0}, b, c, 0.0};
+  m.stress_min = lo;
+  m.stress_max = hi;
+  return m;
+}
+
+TEST(StressHysteresis, ClosedFormReconstructionIsExactOnTheMonotoneBranch) {
+  // D = E + 2 T + 0.01 T^2 on [-50, 50]: dD/dT = 2 + 0.02 T > 0 there (vertex at -100).
+  StressHysteresisReconstructor rec(quadratic_model(2.0, 0.01, -50.0, 50.0));
+  for (const double t : {-60.0, -49.0, -3.5, 0.0, 1e-9, 17.25, 49.9, 80.0}) {
+    const double e = 0.3;
+    const double d = e + 2.0 * t + 0.01 * t * t;
+    const auto est = rec.step(e, d);
+    EXPECT_EQ(est.status, SampleStatus::kOk) << t;
+    EXPECT_NEAR(est.stress, t, 1e-12 * std::max(1.0, std::abs(t))) << t;
+  }
+  // Decreasing branch: D = E - 3 T - 0.02 T^2 on [0, 40], vertex at -75.
+  StressHysteresisReconstructor down(quadratic_model(-3.0, -0.02, 0.0, 40.0));
+  for (const double t : {0.0, 12.0, 39.0}) {
+    const auto est = down.step(0.0, -3.0 * t - 0.02 * t * t);
+    EXPECT_EQ(est.status, SampleStatus::kOk);
+    EXPECT_NEAR(est.stress, t, 1e-12 * std::max(1.0, t));
+  }
+  // c = 0: affine.
+  StressHysteresisReconstructor affine(quadratic_model(4.0, 0.0, -10.0, 10.0));
+  EXPECT_NEAR(affine.step(1.0, 1.0 + 4.0 * 2.5).stress, 2.5, 1e-15);
+}
+
+TEST(StressHysteresis, ClosedFormReportsNonMonotoneAndMissingSolutions) {
+  // Vertex at T = 0 inside [-10, 10]: D = T^2 is not invertible there.
+  StressHysteresisReconstructor rec(quadratic_model(0.0, 1.0, -10.0, 10.0));
+  EXPECT_EQ(rec.step(0.0, 4.0).status, SampleStatus::kNotMonotone);
+  // D = T^2 + 2 T (vertex -1) on [0, 10]: monotone, but D = -5 is below the minimum -1.
+  StressHysteresisReconstructor none(quadratic_model(2.0, 1.0, 0.0, 10.0));
+  const auto est = none.step(0.0, -5.0);
+  EXPECT_EQ(est.status, SampleStatus::kNoSolution);
+  EXPECT_DOUBLE_EQ(est.stress, -1.0);  // the vertex: the stress closest to reproducing D
+  EXPECT_EQ(none.status_counts()[SampleStatus::kNoSolution], 1U);
 }
 
 TEST(StressHysteresis, StateSaveAndRestoreReplaysExactly) {

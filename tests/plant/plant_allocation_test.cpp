@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "plant_test_util.hpp"
-#include "selfsense/plant/plant_yaml.hpp"
+#include "selfsense/plant_io/plant_yaml.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace selfsense::plant {

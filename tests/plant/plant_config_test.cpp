@@ -9,7 +9,7 @@
 
 #include "plant_test_util.hpp"
 #include "selfsense/io/yaml_map.hpp"
-#include "selfsense/plant/plant_yaml.hpp"
+#include "selfsense/plant_io/plant_yaml.hpp"
 
 namespace selfsense::plant {
 namespace {

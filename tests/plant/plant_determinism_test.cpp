@@ -11,7 +11,7 @@
 #include "plant_test_util.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/plant/excitation.hpp"
-#include "selfsense/plant/plant_yaml.hpp"
+#include "selfsense/plant_io/plant_yaml.hpp"
 
 namespace selfsense::plant {
 namespace {

@@ -6,7 +6,7 @@
 
 #include "plant_test_util.hpp"
 #include "selfsense/plant/plant.hpp"
-#include "selfsense/plant/plant_yaml.hpp"
+#include "selfsense/plant_io/plant_yaml.hpp"
 
 namespace selfsense::plant {
 namespace {

@@ -28,6 +28,7 @@
 #include <span>
 #include <vector>
 
+#include "selfsense/models/side_model.hpp"
 #include "selfsense/operators/hysteresis_creep.hpp"
 
 namespace selfsense::identification {
@@ -51,14 +52,8 @@ struct OperatorSignals {
   double sample_time{0.0};                               // [s]
 };
 
-struct OperatorModel {
-  operators::HysteresisCreep::Params op{};
-  std::vector<double> linear_gains{};  // g_k
-  double offset{0.0};
-  double quadratic{0.0};          // y += quadratic * x^2 (electrostriction; set by the caller)
-  std::vector<double> history{};  // input turning points before the first sample
-  double sample_time{0.0};
-};
+// The fitted side (models/side_model.hpp): the runtime models run it without this library.
+using OperatorModel = models::SideModel;
 
 // Throws std::invalid_argument on empty or mismatched signals, a non-positive sample time or
 // a constant input.

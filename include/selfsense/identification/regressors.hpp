@@ -13,40 +13,13 @@
 #include <vector>
 
 #include "selfsense/operators/dead_zone_superposition.hpp"
+#include "selfsense/operators/regressor_stream.hpp"
 
 namespace selfsense::identification {
 
-struct OperatorBasis {
-  std::vector<double> thresholds{};  // r_0 = 0 first; creep thresholds are a subset
-  std::vector<std::size_t> creep_rows{};
-  std::vector<double> eigenvalues{};
-  std::vector<double> gains{};  // a_j = 1 - exp(-lambda_j Ts)
-
-  [[nodiscard]] std::size_t plays() const noexcept { return thresholds.size(); }
-  [[nodiscard]] std::size_t creep() const noexcept {
-    return creep_rows.size() * eigenvalues.size();
-  }
-  [[nodiscard]] std::size_t columns() const noexcept { return plays() + creep(); }
-};
-
-// Operator columns of successive samples, from the state after `history` with settled creep.
-class RegressorStream {
- public:
-  RegressorStream(const OperatorBasis& basis, std::span<const double> history);
-  // Advances with input x; the returned view is valid until the next call. Real-time safe.
-  std::span<const double> next(double x) noexcept;
-
-  // State: the plays, then the creep lags. Saving and restoring copy, never allocate.
-  [[nodiscard]] std::size_t state_size() const noexcept { return plays_.size() + lags_.size(); }
-  void save_state(std::span<double> out) const noexcept;
-  void restore_state(std::span<const double> in) noexcept;
-
- private:
-  const OperatorBasis* basis_;
-  std::vector<double> plays_{};
-  std::vector<double> lags_{};
-  std::vector<double> row_{};
-};
+// OperatorBasis and RegressorStream live with the operators (operators/regressor_stream.hpp).
+using operators::OperatorBasis;
+using operators::RegressorStream;
 
 // Dead-zone thresholds of a superposition (positive side increasing, negative decreasing).
 struct DeadZoneBasis {

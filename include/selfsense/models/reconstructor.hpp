@@ -53,6 +53,10 @@ class ForwardModel final {
   };
   explicit ForwardModel(const TransducerModel& model);
   Output step(double drive, double stress) noexcept;
+  [[nodiscard]] std::optional<SideOperator>& sensor() noexcept { return sensor_; }
+  [[nodiscard]] std::optional<SideOperator>& actuator() noexcept { return actuator_; }
+  [[nodiscard]] const std::optional<SideOperator>& sensor() const noexcept { return sensor_; }
+  [[nodiscard]] const std::optional<SideOperator>& actuator() const noexcept { return actuator_; }
 
   [[nodiscard]] std::size_t state_size() const noexcept;
   void save_state(std::span<double> out) const noexcept;
@@ -73,6 +77,10 @@ class Reconstructor final {
   // (then the measured charge says nothing about stress).
   explicit Reconstructor(const TransducerModel& model);
   Estimate step(double drive, double sensed) noexcept;
+  [[nodiscard]] std::optional<SideOperator>& sensor() noexcept { return sensor_; }
+  [[nodiscard]] std::optional<SideOperator>& actuator() noexcept { return actuator_; }
+  [[nodiscard]] const std::optional<SideOperator>& sensor() const noexcept { return sensor_; }
+  [[nodiscard]] const std::optional<SideOperator>& actuator() const noexcept { return actuator_; }
 
   [[nodiscard]] std::size_t state_size() const noexcept;
   void save_state(std::span<double> out) const noexcept;

@@ -1,12 +1,18 @@
 // Stress-dependent hysteresis: the vectorial case of section 3.3 that the paper leaves as
 // future work, in a form that stays linear in its parameters. With q(E) the play columns of the
-// field history (identification/regressors.hpp: H[E] = W . q),
+// field history (operators/regressor_stream.hpp: H[E] = W . q),
 //   D = W0 . q + T (W1 . q) + d1 T + d2 T^2 + D0       sensor side
 //   S = A0 . q + T (A1 . q) + s1 T + s2 T^2 + S0       actuator side
 // so coupling, permittivity and hysteresis amplitude all change with stress. D is no longer
-// affine in T, so reconstruction solves D_model(E, T) = D_measured for T at every sample with
-// the bracketed solver, which checks that the D-T characteristic is monotone on the bracket
-// (existence and uniqueness of the inverse, eq. 3) and reports when it is not.
+// affine in T but quadratic, so reconstruction solves, at every sample,
+//   c T^2 + b T + (a - D_measured) = 0,   a = W0.q + D0,  b = W1.q + d1,  c = d2
+// in closed form. dD/dT = b + 2 c T is linear in T, so D is strictly monotone over the
+// identified stress range [stress_min, stress_max] exactly when the vertex -b / 2c lies outside
+// it (existence and uniqueness of the inverse, eq. 3): then the solution is the root on that
+// branch, T = (-b + s sqrt(b^2 - 4 c (a - D))) / 2c with s the sign of dD/dT on the range
+// (evaluated in the cancellation-free form). Reported, never hidden: kNotMonotone when the vertex
+// is inside the range, kNoSolution when no real root exists (the estimate is then the vertex,
+// the stress closest to reproducing D).
 #pragma once
 
 #include <array>
@@ -16,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "selfsense/identification/regressors.hpp"
-#include "selfsense/models/bracketed_solver.hpp"
+#include "selfsense/models/sample_status.hpp"
+#include "selfsense/operators/regressor_stream.hpp"
 
 namespace selfsense::models {
 
@@ -34,8 +40,8 @@ struct StressHysteresisSide {
 
 struct StressHysteresisModel {
   double sample_time{0.0};
-  identification::OperatorBasis basis{};  // plays only (no creep)
-  std::vector<double> history{};          // field turning points before the first sample
+  operators::OperatorBasis basis{};  // plays only (no creep)
+  std::vector<double> history{};     // field turning points before the first sample
   std::optional<StressHysteresisSide> sensor{};
   std::optional<StressHysteresisSide> actuator{};
   double stress_min{0.0};  // reconstruction bracket [Pa]
@@ -45,15 +51,6 @@ struct StressHysteresisModel {
   // ordered; names the field ("vectorial.sensor.base has 3 elements ...").
   [[nodiscard]] bool is_valid(std::string* why) const;
 };
-
-// Fits both sides by least squares (W0 partial sums bounded below so the field dependence stays
-// increasing, everything else free). The bracket is the recorded stress range widened by a tenth of
-// its span on each side. Throws std::invalid_argument on mismatched or empty signals.
-[[nodiscard]] StressHysteresisModel fit_stress_hysteresis(std::span<const double> e,
-                                                          std::span<const double> t,
-                                                          std::span<const double> d,
-                                                          std::span<const double> s,
-                                                          double sample_time, std::size_t plays);
 
 // Per-sample forward model (E, T -> D, S); allocation-free after construction.
 class StressHysteresisForward final {
@@ -69,6 +66,9 @@ class StressHysteresisForward final {
   StressHysteresisForward& operator=(StressHysteresisForward&&) = delete;
   ~StressHysteresisForward() = default;
   Output step(double e, double t) noexcept;
+  [[nodiscard]] const StressHysteresisModel& model() const noexcept { return model_; }
+  [[nodiscard]] const operators::RegressorStream& stream() const noexcept { return stream_; }
+  [[nodiscard]] operators::RegressorStream& stream() noexcept { return stream_; }
   // The field history (plays); saved into and restored from caller buffers, no allocation.
   [[nodiscard]] std::size_t state_size() const noexcept { return stream_.state_size(); }
   void save_state(std::span<double> out) const noexcept { stream_.save_state(out); }
@@ -76,7 +76,7 @@ class StressHysteresisForward final {
 
  private:
   StressHysteresisModel model_;  // the stream below points into it: not copyable
-  identification::RegressorStream stream_;
+  operators::RegressorStream stream_;
 };
 
 // Per-sample reconstruction; allocation-free after construction.
@@ -85,10 +85,10 @@ class StressHysteresisReconstructor final {
   struct Estimate {
     double stress{0.0};
     double strain{0.0};  // NaN without an actuator side
-    SolveStatus status{SolveStatus::kOk};
+    SampleStatus status{SampleStatus::kOk};
   };
   // Throws std::invalid_argument without a sensor side. Keeps its own copy of the model.
-  explicit StressHysteresisReconstructor(StressHysteresisModel model, SolverOptions options = {});
+  explicit StressHysteresisReconstructor(StressHysteresisModel model);
   StressHysteresisReconstructor(const StressHysteresisReconstructor&) = delete;
   StressHysteresisReconstructor& operator=(const StressHysteresisReconstructor&) = delete;
   StressHysteresisReconstructor(StressHysteresisReconstructor&&) = delete;
@@ -98,14 +98,16 @@ class StressHysteresisReconstructor final {
   [[nodiscard]] std::size_t state_size() const noexcept { return stream_.state_size(); }
   void save_state(std::span<double> out) const noexcept { stream_.save_state(out); }
   void restore_state(std::span<const double> in) noexcept { stream_.restore_state(in); }
-  // How often each SolveStatus occurred, indexed by its value.
-  [[nodiscard]] const std::array<std::size_t, 4>& status_counts() const noexcept { return counts_; }
+  // How often each status occurred.
+  [[nodiscard]] const StatusCounts& status_counts() const noexcept { return counts_; }
+  [[nodiscard]] const StressHysteresisModel& model() const noexcept { return model_; }
+  [[nodiscard]] const operators::RegressorStream& stream() const noexcept { return stream_; }
+  [[nodiscard]] operators::RegressorStream& stream() noexcept { return stream_; }
 
  private:
   StressHysteresisModel model_;  // the stream below points into it: not copyable
-  SolverOptions options_{};
-  identification::RegressorStream stream_;
-  std::array<std::size_t, 4> counts_{};
+  operators::RegressorStream stream_;
+  StatusCounts counts_{};
 };
 
 }  // namespace selfsense::models

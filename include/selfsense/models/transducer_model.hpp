@@ -1,4 +1,5 @@
-// Transducer models of the paper's section 3 in one form, and their identification.
+// Transducer models of the paper's section 3 in one form (identified by
+// identification/transducer_fit.hpp, run per sample by models/runtime_model.hpp).
 //
 // Field drive (E imposed; eq. 5-15, 26-31):
 //   D = Gs[E] + d * T + D0          sensor side
@@ -26,9 +27,8 @@
 #include <string_view>
 #include <vector>
 
-#include "selfsense/identification/fit_quality.hpp"
-#include "selfsense/identification/operator_fit.hpp"
 #include "selfsense/models/geometry.hpp"
+#include "selfsense/models/side_model.hpp"
 #include "selfsense/models/stress_hysteresis.hpp"
 
 namespace selfsense::models {
@@ -50,9 +50,14 @@ enum class Drive { kField, kCharge };
 // All structure names, for messages: "linear, permittivity, ...".
 [[nodiscard]] std::string structure_names();
 
-// One side of the transducer: y = G[x] + coupling * T + offset, as fitted (OperatorModel with
-// the stress as its only linear input; coupling 0 when the recording had no T).
-using SideModel = identification::OperatorModel;
+// The range a channel covered in the identification recording: the runtime models reject
+// samples far outside it (models/runtime_model.hpp) instead of letting a spike wipe the
+// hysteresis memory.
+struct InputRange {
+  double min{0.0};
+  double max{0.0};
+  [[nodiscard]] double span() const noexcept { return max - min; }
+};
 
 struct TransducerModel {
   Structure structure{Structure::kLinear};
@@ -61,38 +66,12 @@ struct TransducerModel {
   std::optional<SideModel> actuator{};  // x -> S
   std::optional<StressHysteresisModel> vectorial{};  // stress-hysteresis instead of the sides
   std::optional<Geometry> geometry{};                // for terminal quantities
+  std::optional<InputRange> drive_range{};           // x: E (field drive) or D (charge drive)
+  std::optional<InputRange> sensed_range{};          // y: D (field drive) or E (charge drive)
 
   [[nodiscard]] Drive drive() const noexcept { return drive_of(structure); }
   // The operator parameters and couplings are valid and the sample times agree.
   [[nodiscard]] bool is_valid(std::string* why) const;
 };
-
-// Sizes of the operators an identification uses; defaults per structure (defaults_for).
-struct IdentificationOptions {
-  std::size_t plays{0};
-  std::size_t eigenvalues{0};
-  std::size_t creep_plays{0};
-  std::size_t dead_zones{0};
-  bool estimate_history{true};
-  double fastest_eigenvalue{0.0};  // [1/s]; 0: from the sample time (OperatorStructure)
-  double slowest_eigenvalue{0.0};  // [1/s]; 0: from the duration
-};
-[[nodiscard]] IdentificationOptions defaults_for(Structure s) noexcept;
-
-// Recorded signals in field quantities. drive is E (field drive) or D (charge drive), sensed
-// the other one. Empty sensed: no sensor side; empty strain: no actuator side; empty stress:
-// the free actuator (T = 0, couplings not identifiable, so no reconstruction of T).
-struct TransducerSignals {
-  std::span<const double> drive{};
-  std::span<const double> sensed{};
-  std::span<const double> stress{};
-  std::span<const double> strain{};
-  double sample_time{0.0};
-};
-
-// Fits the sides the signals allow. Throws std::invalid_argument on unusable signals (no drive,
-// neither sensed nor strain, mismatched lengths).
-[[nodiscard]] TransducerModel identify(const TransducerSignals& signals, Structure structure,
-                                       const IdentificationOptions& options);
 
 }  // namespace selfsense::models

@@ -5,6 +5,8 @@
 //   structure: hysteresis-creep          # linear | permittivity | hysteresis | ...
 //   sample_time_s: 1.0e-4
 //   geometry: {layer_thickness_m, electrode_area_m2, layers, active_length_m, cross_section_m2}
+//   input_range: {drive: [min, max], sensed: [min, max]}   # optional: the identification
+//                                        # recording's range; the runtime rejects samples far out
 //   sensor:                              # D = S[H[E] + K[E]] + coupling T + offset
 //     coupling: 3.0e-10                  # (charge drive: E = ... of D)
 //     offset: 0.0

@@ -1,4 +1,4 @@
-#include "selfsense/plant/plant_yaml.hpp"
+#include "selfsense/plant_io/plant_yaml.hpp"
 
 #include <array>
 #include <utility>

@@ -1,0 +1,44 @@
+// Identification of a transducer model (models/transducer_model.hpp) from recorded signals:
+// one entry point for every structure. The sides are fitted by fit_operator (operator_fit.hpp),
+// the stress-dependent model by fit_stress_hysteresis. Not real-time code.
+#pragma once
+
+#include <cstddef>
+#include <span>
+
+#include "selfsense/models/transducer_model.hpp"
+
+namespace selfsense::identification {
+
+using models::Structure;
+using models::TransducerModel;
+
+// Sizes of the operators an identification uses; defaults per structure (defaults_for).
+struct IdentificationOptions {
+  std::size_t plays{0};
+  std::size_t eigenvalues{0};
+  std::size_t creep_plays{0};
+  std::size_t dead_zones{0};
+  bool estimate_history{true};
+  double fastest_eigenvalue{0.0};  // [1/s]; 0: from the sample time (OperatorStructure)
+  double slowest_eigenvalue{0.0};  // [1/s]; 0: from the duration
+};
+[[nodiscard]] IdentificationOptions defaults_for(Structure s) noexcept;
+
+// Recorded signals in field quantities. drive is E (field drive) or D (charge drive), sensed
+// the other one. Empty sensed: no sensor side; empty strain: no actuator side; empty stress:
+// the free actuator (T = 0, couplings not identifiable, so no reconstruction of T).
+struct TransducerSignals {
+  std::span<const double> drive{};
+  std::span<const double> sensed{};
+  std::span<const double> stress{};
+  std::span<const double> strain{};
+  double sample_time{0.0};
+};
+
+// Fits the sides the signals allow. Throws std::invalid_argument on unusable signals (no drive,
+// neither sensed nor strain, mismatched lengths).
+[[nodiscard]] TransducerModel identify(const TransducerSignals& signals, Structure structure,
+                                       const IdentificationOptions& options);
+
+}  // namespace selfsense::identification

@@ -1,0 +1,83 @@
+#include "selfsense/models/model_identity.hpp"
+
+#include <bit>
+#include <span>
+
+namespace selfsense::models {
+namespace {
+
+// FNV-1a, 64 bit, fed with the bit patterns of the parameters.
+class Fnv1a {
+ public:
+  void add(std::uint64_t word) noexcept {
+    for (int byte = 0; byte < 8; ++byte) {
+      hash_ ^= (word >> (8 * byte)) & 0xffU;
+      hash_ *= kPrime;
+    }
+  }
+  void add(double x) noexcept { add(std::bit_cast<std::uint64_t>(x)); }
+  // The length first, so [1, 2] + [] and [1] + [2] hash differently.
+  void add(std::span<const double> xs) noexcept {
+    add(static_cast<std::uint64_t>(xs.size()));
+    for (const double x : xs)
+      add(x);
+  }
+  [[nodiscard]] std::uint64_t value() const noexcept { return hash_; }
+
+ private:
+  static constexpr std::uint64_t kPrime = 1099511628211ULL;
+  std::uint64_t hash_{14695981039346656037ULL};
+};
+
+void add_side(Fnv1a& h, const std::optional<SideModel>& side) noexcept {
+  h.add(static_cast<std::uint64_t>(side.has_value()));
+  if (!side) return;
+  const auto& op = side->op;
+  h.add(op.hysteresis.linear_weight);
+  h.add(op.hysteresis.thresholds);
+  h.add(op.hysteresis.weights);
+  h.add(op.superposition.linear_weight);
+  h.add(op.superposition.upper_thresholds);
+  h.add(op.superposition.upper_weights);
+  h.add(op.superposition.lower_thresholds);
+  h.add(op.superposition.lower_weights);
+  h.add(op.creep.thresholds);
+  h.add(op.creep.eigenvalues);
+  h.add(op.creep.weights);
+  h.add(side->linear_gains);
+  h.add(side->offset);
+  h.add(side->quadratic);
+  h.add(side->history);
+}
+
+void add_vectorial_side(Fnv1a& h, const std::optional<StressHysteresisSide>& side) noexcept {
+  h.add(static_cast<std::uint64_t>(side.has_value()));
+  if (!side) return;
+  h.add(side->base);
+  h.add(side->stress);
+  h.add(side->linear);
+  h.add(side->quadratic);
+  h.add(side->offset);
+}
+
+}  // namespace
+
+std::uint64_t parameter_hash(const TransducerModel& model) noexcept {
+  Fnv1a h;
+  h.add(static_cast<std::uint64_t>(model.structure));
+  add_side(h, model.sensor);
+  add_side(h, model.actuator);
+  h.add(static_cast<std::uint64_t>(model.vectorial.has_value()));
+  if (model.vectorial) {
+    const StressHysteresisModel& v = *model.vectorial;
+    h.add(v.basis.thresholds);
+    h.add(v.history);
+    h.add(v.stress_min);
+    h.add(v.stress_max);
+    add_vectorial_side(h, v.sensor);
+    add_vectorial_side(h, v.actuator);
+  }
+  return h.value();
+}
+
+}  // namespace selfsense::models

@@ -1,0 +1,304 @@
+#include "selfsense/models/runtime_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "carry_over.hpp"
+
+namespace selfsense::models {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The model with its sides discretised for the loop's sample time.
+TransducerModel at_sample_time(TransducerModel model, double ts) {
+  model.sample_time = ts;
+  if (model.sensor) model.sensor->sample_time = ts;
+  if (model.actuator) model.actuator->sample_time = ts;
+  if (model.vectorial) model.vectorial->sample_time = ts;
+  return model;
+}
+
+double loop_sample_time(const TransducerModel& model, const RuntimeOptions& options) {
+  std::string why;
+  if (!options.is_valid(&why)) throw std::invalid_argument(why);
+  return options.sample_time > 0.0 ? options.sample_time : model.sample_time;
+}
+
+detail::OperatorMemory memory_of(const operators::HysteresisCreep& op) noexcept {
+  const std::span<const double> state = op.state();
+  const std::size_t n = op.play_thresholds().size();
+  return {op.play_thresholds(), state.first(n), op.params().creep.thresholds,
+          op.params().creep.eigenvalues, state.subspan(n)};
+}
+
+detail::OperatorMemory memory_of(const operators::RegressorStream& stream) noexcept {
+  return {stream.basis().thresholds, stream.plays(), {}, {}, {}};
+}
+
+// Creep thresholds of a regressor stream are a subset of its plays; the stress-dependent model
+// has none, so its carry-over is plays only.
+void adopt_side(const detail::ModelMemory& from, SideOperator& side,
+                std::span<double> scratch) noexcept {
+  operators::HysteresisCreep& op = side.op();
+  const std::span<double> state = scratch.first(op.state().size());
+  detail::carry_over(from, op.play_thresholds(), op.params().creep.thresholds,
+                     op.params().creep.eigenvalues, state);
+  op.set_state(state);
+}
+
+void adopt_stream(const detail::ModelMemory& from, operators::RegressorStream& stream,
+                  std::span<double> scratch) noexcept {
+  const std::span<double> state = scratch.first(stream.state_size());
+  detail::carry_over(from, stream.basis().thresholds, {}, {}, state);
+  stream.restore_state(state);
+}
+
+// The input before the first sample: the last turning point of the identified history.
+double initial_input(const TransducerModel& model) noexcept {
+  const std::vector<double>* h = nullptr;
+  if (model.vectorial) {
+    h = &model.vectorial->history;
+  } else if (model.sensor) {
+    h = &model.sensor->history;
+  } else if (model.actuator) {
+    h = &model.actuator->history;
+  }
+  return (h != nullptr && !h->empty()) ? h->back() : 0.0;
+}
+
+// The variants hold the affine kernels by value and the vectorial ones (not movable) by pointer.
+template <typename M>
+decltype(auto) kernel(M& m) noexcept {
+  if constexpr (requires { *m; }) {
+    return *m;
+  } else {
+    return (m);
+  }
+}
+
+template <typename Impl>
+bool save_into(const Impl& impl, const ModelIdentity& identity, SavedState& out) noexcept {
+  if (out.values.size() != identity.state_size) return false;
+  std::visit([&](const auto& m) { kernel(m).save_state(out.values); }, impl);
+  out.identity = identity;
+  return true;
+}
+
+template <typename Impl>
+RestoreResult restore_from(Impl& impl, const ModelIdentity& identity,
+                           const SavedState& in) noexcept {
+  if (in.identity.structure != identity.structure ||
+      in.identity.parameter_hash != identity.parameter_hash) {
+    return RestoreResult::kWrongModel;
+  }
+  if (in.identity.state_size != identity.state_size || in.values.size() != identity.state_size) {
+    return RestoreResult::kWrongSize;
+  }
+  std::visit([&](auto& m) { kernel(m).restore_state(in.values); }, impl);
+  return RestoreResult::kOk;
+}
+
+template <typename Impl>
+std::size_t state_size_of(const Impl& impl) noexcept {
+  return std::visit([](const auto& m) { return kernel(m).state_size(); }, impl);
+}
+
+}  // namespace
+
+bool RuntimeOptions::is_valid(std::string* why) const {
+  const auto fail = [why](const char* message) {
+    if (why != nullptr) *why = message;
+    return false;
+  };
+  if (!(std::isfinite(sample_time) && sample_time >= 0.0)) {
+    return fail("runtime.sample_time: must be finite and >= 0 (0: the model's own)");
+  }
+  if (!(std::isfinite(range_margin) && range_margin >= 0.0)) {
+    return fail("runtime.range_margin: must be finite and >= 0");
+  }
+  return true;
+}
+
+namespace detail {
+
+InputGate::InputGate(const std::optional<InputRange>& first,
+                     const std::optional<InputRange>& second, double margin) noexcept {
+  const std::optional<InputRange>* ranges[2] = {&first, &second};
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (!ranges[i]->has_value()) continue;
+    const InputRange& r = **ranges[i];
+    ranged_[i] = true;
+    lo_[i] = r.min - margin * r.span();
+    hi_[i] = r.max + margin * r.span();
+  }
+}
+
+SampleStatus InputGate::check(double first, double second) const noexcept {
+  if (!std::isfinite(first) || !std::isfinite(second)) return SampleStatus::kInputNotFinite;
+  const double x[2] = {first, second};
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (ranged_[i] && (x[i] < lo_[i] || x[i] > hi_[i])) return SampleStatus::kInputOutOfRange;
+  }
+  return SampleStatus::kOk;
+}
+
+}  // namespace detail
+
+// ---- Reconstruction ----
+
+namespace {
+
+std::variant<Reconstructor, std::unique_ptr<StressHysteresisReconstructor>> make_reconstruction(
+    const TransducerModel& model) {
+  if (model.vectorial) {
+    return std::make_unique<StressHysteresisReconstructor>(*model.vectorial);
+  }
+  return Reconstructor(model);
+}
+
+std::variant<ForwardModel, std::unique_ptr<StressHysteresisForward>> make_simulation(
+    const TransducerModel& model) {
+  if (model.vectorial) return std::make_unique<StressHysteresisForward>(*model.vectorial);
+  return ForwardModel(model);
+}
+
+}  // namespace
+
+Reconstruction::Reconstruction(const TransducerModel& model, const RuntimeOptions& options)
+    : impl_(make_reconstruction(at_sample_time(model, loop_sample_time(model, options)))),
+      gate_(model.drive_range, model.sensed_range, options.range_margin),
+      sample_time_(loop_sample_time(model, options)),
+      identified_ts_(model.sample_time),
+      last_{0.0, kNaN, SampleStatus::kOk} {
+  identity_ = {model.structure, parameter_hash(model), state_size_of(impl_)};
+  scratch_.resize(identity_.state_size);
+  last_drive_ = initial_input(model);
+}
+
+bool Reconstruction::has_strain() const noexcept {
+  if (const auto* affine = std::get_if<Affine>(&impl_)) return affine->actuator().has_value();
+  return std::get<Vectorial>(impl_)->model().actuator.has_value();
+}
+
+Reconstruction::Estimate Reconstruction::step(double drive, double sensed) noexcept {
+  const SampleStatus gate = gate_.check(drive, sensed);
+  if (gate != SampleStatus::kOk) {
+    counts_.add(gate);
+    // Held input: the plays keep their memory, the creep lags keep time.
+    if (last_valid_) {
+      const Estimate held = kernel_step(last_drive_, last_sensed_);
+      last_ = {held.stress, held.strain, last_.status};
+    }
+    return {last_.stress, last_.strain, gate};
+  }
+  const Estimate out = kernel_step(drive, sensed);
+  counts_.add(out.status);
+  last_drive_ = drive;
+  last_sensed_ = sensed;
+  last_valid_ = true;
+  last_ = out;
+  return out;
+}
+
+Reconstruction::Estimate Reconstruction::kernel_step(double drive, double sensed) noexcept {
+  if (auto* affine = std::get_if<Affine>(&impl_)) {
+    const Reconstructor::Estimate e = affine->step(drive, sensed);
+    return {e.stress, e.strain, SampleStatus::kOk};
+  }
+  const StressHysteresisReconstructor::Estimate e = std::get<Vectorial>(impl_)->step(drive, sensed);
+  return {e.stress, e.strain, e.status};
+}
+
+SavedState Reconstruction::make_saved_state() const {
+  return {identity_, std::vector<double>(identity_.state_size, 0.0)};
+}
+
+bool Reconstruction::save_state(SavedState& out) const noexcept {
+  return save_into(impl_, identity_, out);
+}
+
+RestoreResult Reconstruction::restore_state(const SavedState& in) noexcept {
+  return restore_from(impl_, identity_, in);
+}
+
+void Reconstruction::memory(detail::ModelMemory& out) const noexcept {
+  out.last_input = last_drive_;
+  if (const auto* affine = std::get_if<Affine>(&impl_)) {
+    if (affine->sensor()) out.add(memory_of(affine->sensor()->op()));
+    if (affine->actuator()) out.add(memory_of(affine->actuator()->op()));
+  } else {
+    out.add(memory_of(std::get<Vectorial>(impl_)->stream()));
+  }
+}
+
+void Reconstruction::adopt_state(const Reconstruction& running) noexcept {
+  detail::ModelMemory from;
+  running.memory(from);
+  if (auto* affine = std::get_if<Affine>(&impl_)) {
+    if (affine->sensor()) adopt_side(from, *affine->sensor(), scratch_);
+    if (affine->actuator()) adopt_side(from, *affine->actuator(), scratch_);
+  } else {
+    adopt_stream(from, std::get<Vectorial>(impl_)->stream(), scratch_);
+  }
+  last_drive_ = running.last_drive_;
+  last_sensed_ = running.last_sensed_;
+  last_valid_ = running.last_valid_;
+  last_ = running.last_;
+}
+
+// ---- Simulation ----
+
+Simulation::Simulation(const TransducerModel& model, const RuntimeOptions& options)
+    : impl_(make_simulation(at_sample_time(model, loop_sample_time(model, options)))),
+      gate_(model.drive_range, std::nullopt, options.range_margin),
+      sample_time_(loop_sample_time(model, options)),
+      identified_ts_(model.sample_time),
+      last_{kNaN, kNaN, SampleStatus::kOk} {
+  identity_ = {model.structure, parameter_hash(model), state_size_of(impl_)};
+}
+
+Simulation::Output Simulation::step(double drive, double stress) noexcept {
+  const SampleStatus gate = gate_.check(drive, stress);
+  if (gate != SampleStatus::kOk) {
+    counts_.add(gate);
+    if (last_valid_) {
+      const Output held = kernel_step(last_drive_, last_stress_);
+      last_ = {held.sensed, held.strain, last_.status};
+    }
+    return {last_.sensed, last_.strain, gate};
+  }
+  const Output out = kernel_step(drive, stress);
+  counts_.add(out.status);
+  last_drive_ = drive;
+  last_stress_ = stress;
+  last_valid_ = true;
+  last_ = out;
+  return out;
+}
+
+Simulation::Output Simulation::kernel_step(double drive, double stress) noexcept {
+  if (auto* affine = std::get_if<Affine>(&impl_)) {
+    const ForwardModel::Output o = affine->step(drive, stress);
+    return {o.sensed, o.strain, SampleStatus::kOk};
+  }
+  const StressHysteresisForward::Output o = std::get<Vectorial>(impl_)->step(drive, stress);
+  return {o.sensed, o.strain, SampleStatus::kOk};
+}
+
+SavedState Simulation::make_saved_state() const {
+  return {identity_, std::vector<double>(identity_.state_size, 0.0)};
+}
+
+bool Simulation::save_state(SavedState& out) const noexcept {
+  return save_into(impl_, identity_, out);
+}
+
+RestoreResult Simulation::restore_state(const SavedState& in) noexcept {
+  return restore_from(impl_, identity_, in);
+}
+
+}  // namespace selfsense::models

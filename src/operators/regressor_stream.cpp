@@ -1,0 +1,56 @@
+#include "selfsense/operators/regressor_stream.hpp"
+
+#include <algorithm>
+#include <cassert>
+
+#include "selfsense/operators/kernels.hpp"
+
+namespace selfsense::operators {
+
+RegressorStream::RegressorStream(const OperatorBasis& basis, std::span<const double> history)
+    : basis_(&basis),
+      plays_(basis.plays(), history.empty() ? 0.0 : history.front()),
+      lags_(basis.creep()),
+      row_(basis.columns()) {
+  for (const double h : history)
+    kernels::play_bank_step(h, basis.thresholds, plays_);
+  const std::size_t n_eig = basis.eigenvalues.size();
+  for (std::size_t i = 0; i < basis.creep_rows.size(); ++i) {
+    std::fill_n(lags_.begin() + static_cast<std::ptrdiff_t>(i * n_eig), n_eig,
+                plays_[basis.creep_rows[i]]);
+  }
+}
+
+std::span<const double> RegressorStream::next(double x) noexcept {
+  const OperatorBasis& b = *basis_;
+  kernels::play_bank_step(x, b.thresholds, plays_);
+  const std::size_t n = plays_.size();
+  for (std::size_t i = 0; i + 1 < n; ++i)
+    row_[i] = plays_[i] - plays_[i + 1];
+  row_[n - 1] = plays_[n - 1];
+  const std::size_t n_eig = b.eigenvalues.size();
+  std::size_t c = n;
+  for (std::size_t i = 0; i < b.creep_rows.size(); ++i) {
+    const double p = plays_[b.creep_rows[i]];
+    for (std::size_t j = 0; j < n_eig; ++j) {
+      double& z = lags_[i * n_eig + j];
+      z += b.gains[j] * (p - z);
+      row_[c++] = z;
+    }
+  }
+  return row_;
+}
+
+void RegressorStream::save_state(std::span<double> out) const noexcept {
+  assert(out.size() == state_size());
+  std::copy(plays_.begin(), plays_.end(), out.begin());
+  std::copy(lags_.begin(), lags_.end(), out.begin() + static_cast<std::ptrdiff_t>(plays_.size()));
+}
+
+void RegressorStream::restore_state(std::span<const double> in) noexcept {
+  assert(in.size() == state_size());
+  std::copy_n(in.begin(), plays_.size(), plays_.begin());
+  std::copy(in.begin() + static_cast<std::ptrdiff_t>(plays_.size()), in.end(), lags_.begin());
+}
+
+}  // namespace selfsense::operators

@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# The build's layering, as a check that fails (architecture.md): every header and source of a
+# library may include project headers only from the libraries it is allowed to depend on, and the
+# pure-math libraries include nothing that does files, threads, sockets or formats.
+#
+#   check_layering.sh SOURCE_DIR
+# Prints one line per violation (FILE:LINE: what) and exits 1 if there is any.
+set -euo pipefail
+root=${1:?usage: check_layering.sh SOURCE_DIR}
+cd "$root"
+
+# library folder -> the include folders it may use (itself first). A folder missing here is
+# not checked (the tools and tests may use everything).
+declare -A allowed=(
+  [operators]="operators"
+  [models]="models operators"
+  [control]="control"
+  [plant]="plant"
+  [identification]="identification models operators"
+  [io]="io"
+  [model_io]="model_io models operators io"
+  [plant_io]="plant_io plant io"
+  [runtime]="runtime models operators control"
+)
+# The math: no files, streams, threads, clocks, sockets or file formats.
+math="operators models control plant identification"
+forbidden_system='fstream|iostream|filesystem|thread|mutex|condition_variable|future|chrono|cstdio|yaml-cpp/.*|nlohmann/.*|sys/.*|unistd\.h|fcntl\.h|pthread\.h'
+
+violations=0
+report() {
+  echo "$1"
+  violations=$((violations + 1))
+}
+
+for lib in "${!allowed[@]}"; do
+  for dir in "include/selfsense/$lib" "src/$lib"; do
+    [ -d "$dir" ] || continue
+    while IFS= read -r hit; do
+      file=${hit%%:*}
+      rest=${hit#*:}
+      line=${rest%%:*}
+      target=$(sed -E 's/.*#include "selfsense\/([a-z_]+)\/.*/\1/' <<<"$rest")
+      ok=0
+      for a in ${allowed[$lib]}; do
+        [ "$a" = "$target" ] && ok=1
+      done
+      [ $ok -eq 1 ] || report "$file:$line: $lib must not include selfsense/$target (allowed: ${allowed[$lib]})"
+    done < <(grep -rnE '^#include "selfsense/[a-z_]+/' "$dir" || true)
+    if [[ " $math " == *" $lib "* ]]; then
+      while IFS= read -r hit; do
+        report "${hit%%:#*}: pure math ($lib) must not include ${hit#*#include }"
+      done < <(grep -rnE "^#include <($forbidden_system)>" "$dir" || true)
+    fi
+  done
+done
+
+# Every library folder must be known here, so a new one cannot slip past the check.
+for dir in src/*/; do
+  lib=$(basename "$dir")
+  case "$lib" in cli | daemon) continue ;; esac
+  [ -n "${allowed[$lib]+x}" ] || report "src/$lib: library folder not in tests/layering/check_layering.sh"
+done
+
+if [ "$violations" -gt 0 ]; then
+  echo "layering: $violations violation(s)" >&2
+  exit 1
+fi
+echo "layering: ok (${#allowed[@]} libraries)"
