@@ -42,7 +42,9 @@ void read_simulated(io::YamlMap& driver, const daemon::DaemonConfig& config,
 
 }  // namespace
 
-std::string driver_types() { return "simulated"; }
+std::string driver_types() {
+  return "simulated";
+}
 
 void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
                     std::vector<std::string>& problems) {

@@ -190,9 +190,9 @@ void read_socket(YamlMap s, SocketSection& out, const std::filesystem::path& bas
 void validate(const DaemonConfig& c, Problems& p) {
   const double fs = c.loop.rate_hz;
   p.check(fs >= 100.0 && fs <= 100000.0, "loop.rate_hz",
-                number(fs) + " must be within [100, 100000]");
+          number(fs) + " must be within [100, 100000]");
   p.check(c.loop.priority >= 1 && c.loop.priority <= 99, "loop.priority",
-                std::to_string(c.loop.priority) + " must be within [1, 99] (SCHED_FIFO)");
+          std::to_string(c.loop.priority) + " must be within [1, 99] (SCHED_FIFO)");
   p.check(c.loop.cpu >= -1, "loop.cpu", "must be -1 (any) or a CPU index");
   p.check(c.loop.status_period_cycles >= 1, "loop.status_period_cycles", "must be >= 1");
   if (!(fs > 0.0)) return;
@@ -201,7 +201,7 @@ void validate(const DaemonConfig& c, Problems& p) {
   const runtime::ControllerConfig& k = c.control;
   p.check(k.command_min < k.command_max, "control.command_v_per_m", "min must be < max");
   p.check(k.force_direction == 1.0 || k.force_direction == -1.0, "control.force_direction",
-                "must be 1 or -1");
+          "must be 1 or -1");
   for (const auto& [name, pid] :
        {std::pair{"control.position", &k.position}, std::pair{"control.force", &k.force}}) {
     if (!pid->is_valid(ts, &why)) p.add(std::string(name) + ": " + why);
@@ -222,25 +222,25 @@ void validate(const DaemonConfig& c, Problems& p) {
   p.check(s.strain.min < s.strain.max, "safety.strain_range", "min must be < max");
   p.check(s.stress_pa.min < s.stress_pa.max, "safety.stress_range_pa", "min must be < max");
   p.check(s.setpoint_strain.min >= s.strain.min && s.setpoint_strain.max <= s.strain.max &&
-                    s.setpoint_strain.min < s.setpoint_strain.max,
-                "safety.setpoint_strain", "must be an interval inside safety.strain_range");
+              s.setpoint_strain.min < s.setpoint_strain.max,
+          "safety.setpoint_strain", "must be an interval inside safety.strain_range");
   p.check(s.setpoint_stress_pa.min >= s.stress_pa.min &&
-                    s.setpoint_stress_pa.max <= s.stress_pa.max &&
-                    s.setpoint_stress_pa.min < s.setpoint_stress_pa.max,
-                "safety.setpoint_stress_pa", "must be an interval inside safety.stress_range_pa");
+              s.setpoint_stress_pa.max <= s.stress_pa.max &&
+              s.setpoint_stress_pa.min < s.setpoint_stress_pa.max,
+          "safety.setpoint_stress_pa", "must be an interval inside safety.stress_range_pa");
   p.check(s.safe_value_v_per_m >= k.command_min && s.safe_value_v_per_m <= k.command_max,
-                "safety.safe_value_v_per_m", "must be inside control.command_v_per_m");
+          "safety.safe_value_v_per_m", "must be inside control.command_v_per_m");
   if (!s.overrun.is_valid(&why)) p.add(why);
   p.check(s.watchdog_s >= 0.0, "safety.watchdog_s", "must be >= 0");
   const RecorderSection& r = c.recorder;
   p.check(r.rotate_bytes >= 4096, "recorder.rotate_bytes", "must be >= 4096");
   p.check(r.flush_ms >= 1.0 && r.flush_ms <= 60000.0, "recorder.flush_ms",
-                "must be within [1, 60000]");
+          "must be within [1, 60000]");
   p.check(r.ring_capacity >= 1024, "recorder.ring_capacity", "must be >= 1024");
-  p.check(r.flight_recorder_s >= 0.0 && r.flight_recorder_s <= 60.0,
-                "recorder.flight_recorder_s", "must be within [0, 60]");
+  p.check(r.flight_recorder_s >= 0.0 && r.flight_recorder_s <= 60.0, "recorder.flight_recorder_s",
+          "must be within [0, 60]");
   p.check(c.socket.max_clients >= 1 && c.socket.max_clients <= 1024, "socket.max_clients",
-                "must be within [1, 1024]");
+          "must be within [1, 1024]");
   p.check(c.telemetry.period_s > 0.0, "telemetry.period_s", "must be > 0");
 }
 

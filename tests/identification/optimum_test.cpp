@@ -163,9 +163,9 @@ models::TransducerModel library_fit(const test::OperatorRecording& r, std::size_
   o.dead_zones = dead_zones;
   o.eigenvalues = eigenvalues;
   o.creep_plays = creep_plays;
-  const identification::TransducerSignals s{std::span(r.e).first(fit_to), std::span(r.d).first(fit_to),
-                                    std::span(r.t).first(fit_to), std::span(r.s).first(fit_to),
-                                    kTs};
+  const identification::TransducerSignals s{
+      std::span(r.e).first(fit_to), std::span(r.d).first(fit_to), std::span(r.t).first(fit_to),
+      std::span(r.s).first(fit_to), kTs};
   return identification::identify(
       s, eigenvalues > 0 ? models::Structure::kHysteresisCreep : models::Structure::kHysteresis, o);
 }

@@ -90,6 +90,7 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
       }
     }
     EXPECT_EQ(counter.count(), 0U);
+    EXPECT_EQ(counter.locks(), 0U);
   }
   Retired r;
   while (loop.take_retired(r)) {
