@@ -24,6 +24,7 @@
 #include "selfsense/runtime/driver.hpp"
 #include "selfsense/runtime/loop_command.hpp"
 #include "selfsense/runtime/loop_sample.hpp"
+#include "selfsense/runtime/latest_value.hpp"
 #include "selfsense/runtime/spsc_ring.hpp"
 #include "selfsense/runtime/status_snapshot.hpp"
 #include "selfsense/runtime/supervisor.hpp"
