@@ -15,8 +15,8 @@ namespace selfsense::cli {
 
 void add_check_config_command(CLI::App& app) {
   auto path = std::make_shared<std::filesystem::path>();
-  CLI::App* cmd = app.add_subcommand(
-      "check-config", "Validate a selfsensed configuration; print every problem");
+  CLI::App* cmd = app.add_subcommand("check-config",
+                                     "Validate a selfsensed configuration; print every problem");
   cmd->add_option("config", *path, "Daemon configuration (YAML)")->required();
   cmd->callback([path] {
     drivers::Registry registry;

@@ -1,0 +1,90 @@
+// selfsensed, assembled: the driver, the model, the control law and the supervisor in the
+// real-time loop (runtime::LoopRunner), the recorder's writer thread, the control socket and
+// the main thread, which handles signals, systemd notification and telemetry. Not real-time
+// code; the loop thread is the only real-time one.
+//
+// Signals (blocked in every thread, taken by the main thread with sigtimedwait):
+//   SIGTERM, SIGINT   disarm (the loop writes the safe output from the next cycle), stop the
+//                     loop, drive the amplifier to its safe output (driver deactivate), flush and
+//                     close the recorder, STOPPING=1, exit 0
+//   SIGHUP            reload the parameters that are safe to change while armed (the gains);
+//                     any other changed key is refused with a message naming it
+// systemd (Type=notify): READY=1 once the loop runs, STATUS= every second, WATCHDOG=1 only while
+// the loop makes progress (a stalled loop gets the service restarted), STOPPING=1.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "selfsense/daemon/config.hpp"
+#include "selfsense/daemon/recorder.hpp"
+#include "selfsense/runtime/driver.hpp"
+#include "selfsense/runtime/loop.hpp"
+#include "selfsense/runtime/loop_runner.hpp"
+#include "selfsense/runtime/pacer.hpp"
+
+namespace selfsense::daemon {
+
+class Daemon final {
+ public:
+  // Builds everything (loads the model, configures and activates the driver, prepares the
+  // recorder); throws std::runtime_error naming what failed. Starts no thread.
+  Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver);
+  Daemon(const Daemon&) = delete;
+  Daemon& operator=(const Daemon&) = delete;
+  Daemon(Daemon&&) = delete;
+  Daemon& operator=(Daemon&&) = delete;
+  ~Daemon();
+
+  // Runs until SIGTERM or SIGINT; returns the exit status. Call from the main thread with
+  // SIGTERM, SIGINT and SIGHUP blocked (block_signals() before any thread starts).
+  int run();
+  static void block_signals();
+
+  // For the control handler (any non-real-time thread).
+  // Sends a command and waits for the loop's answer (nullopt on timeout).
+  std::optional<runtime::LoopAnswer> command(runtime::LoopCommand c,
+                                             std::chrono::milliseconds timeout);
+  [[nodiscard]] runtime::StatusSnapshot status() const noexcept { return loop_->status(); }
+  [[nodiscard]] const DaemonConfig& config() const noexcept { return config_; }
+  [[nodiscard]] Recorder& recorder() noexcept { return *recorder_; }
+  [[nodiscard]] const runtime::Driver& driver() const noexcept { return *driver_; }
+  // Real-time set-up problems; arming is refused while any exists unless degraded timing is
+  // allowed by the configuration.
+  [[nodiscard]] const runtime::RtSetupResult& rt_setup() const noexcept { return rt_setup_; }
+  [[nodiscard]] bool degraded_timing() const noexcept { return !rt_setup_.complete(); }
+  [[nodiscard]] bool may_arm() const noexcept {
+    return rt_setup_.complete() || config_.loop.allow_degraded_timing;
+  }
+  // The problems of the last reload (empty: applied).
+  std::vector<std::string> reload();
+  // Test hook for the watchdog: the loop stops making progress.
+  void stall_loop(bool on) noexcept { runner_->stall(on); }
+  void request_stop() noexcept { stop_requested_.store(true); }
+
+ private:
+  class Sink;
+  void free_retired();
+  void notify_status();
+  void write_telemetry();
+
+  DaemonConfig config_;
+  std::unique_ptr<runtime::Driver> driver_;
+  std::unique_ptr<Recorder> recorder_;
+  std::unique_ptr<Sink> sink_;
+  runtime::SteadyClock clock_{};
+  std::unique_ptr<runtime::Loop> loop_;
+  std::unique_ptr<runtime::LoopRunner> runner_;
+  runtime::RtSetupResult rt_setup_{};
+  std::mutex command_mutex_{};  // one producer and one answer reader at a time
+  std::uint64_t next_id_{0};
+  std::atomic<bool> stop_requested_{false};
+};
+
+}  // namespace selfsense::daemon

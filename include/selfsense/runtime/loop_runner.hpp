@@ -1,0 +1,57 @@
+// The real-time thread: real-time set-up once, then the loop paced to absolute deadlines
+// (Pacer on CLOCK_MONOTONIC), each cycle's execution time and wake-up latency measured and
+// published with the loop's status. progress() counts finished cycles: the daemon pings the
+// systemd watchdog only while it advances, so a stalled loop gets the service restarted.
+//
+//   start()  spawns the thread (not real-time); stop() asks it to finish its cycle and joins.
+// Inside the thread nothing allocates, locks or does I/O after the set-up.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+#include "selfsense/runtime/loop.hpp"
+#include "selfsense/runtime/pacer.hpp"
+#include "selfsense/runtime/rt_setup.hpp"
+
+namespace selfsense::runtime {
+
+class LoopRunner final {
+ public:
+  LoopRunner(Loop& loop, Clock& clock, std::int64_t period_ns, const RtOptions& rt);
+  LoopRunner(const LoopRunner&) = delete;
+  LoopRunner& operator=(const LoopRunner&) = delete;
+  LoopRunner(LoopRunner&&) = delete;
+  LoopRunner& operator=(LoopRunner&&) = delete;
+  ~LoopRunner();
+
+  // Starts the thread and waits for its real-time set-up; the result says what failed.
+  RtSetupResult start();
+  void stop();
+  [[nodiscard]] std::uint64_t progress() const noexcept {
+    return progress_.load(std::memory_order_relaxed);
+  }
+  // Test hook: the loop thread stops cycling (simulates a stalled loop) without exiting.
+  void stall(bool on) noexcept { stall_.store(on, std::memory_order_relaxed); }
+
+ private:
+  void run();
+
+  Loop* loop_;
+  Clock* clock_;
+  std::int64_t period_ns_;
+  RtOptions rt_;
+  std::thread thread_{};
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> stall_{false};
+  std::atomic<std::uint64_t> progress_{0};
+  std::mutex setup_mutex_{};  // hands the set-up result to start(); never used by the cycle
+  bool setup_done_{false};
+  RtSetupResult setup_{};
+  std::condition_variable setup_cv_{};
+};
+
+}  // namespace selfsense::runtime

@@ -1,0 +1,276 @@
+#include "selfsense/daemon/daemon.hpp"
+
+#include <systemd/sd-daemon.h>
+
+#include <csignal>
+#include <cstdio>
+#include <ctime>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "selfsense/daemon/prometheus.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
+#include "selfsense/models/runtime_model.hpp"
+#include "selfsense/control/wave_generator.hpp"
+#include "selfsense/runtime/controller.hpp"
+#include "selfsense/runtime/supervisor.hpp"
+
+namespace selfsense::daemon {
+
+// The recorder's ring as the loop's sample sink.
+class Daemon::Sink final : public runtime::SampleSink {
+ public:
+  explicit Sink(Recorder& recorder) : recorder_(&recorder) {}
+  bool push(const runtime::LoopSample& sample) noexcept override {
+    return recorder_->push(sample);
+  }
+
+ private:
+  Recorder* recorder_;
+};
+
+namespace {
+
+RecorderConfig recorder_config(const DaemonConfig& c, bool references) {
+  RecorderConfig r;
+  r.directory = c.recorder.directory;
+  r.prefix = "selfsensed";
+  r.rotate_bytes = static_cast<std::size_t>(c.recorder.rotate_bytes);
+  r.flush_period_ms = c.recorder.flush_ms;
+  r.ring_capacity = c.recorder.ring_capacity;
+  r.references = references;
+  r.sample_time_s = c.sample_time();
+  r.comments = {"config " + c.source.string(), "model " + c.model.string()};
+  r.flight.seconds = c.recorder.flight_recorder_s;
+  return r;
+}
+
+std::string fault_name(unsigned bit) {
+  return std::string(runtime::to_string(static_cast<runtime::Fault>(bit)));
+}
+
+const char* state_name(runtime::LoopState s) {
+  switch (s) {
+    case runtime::LoopState::kArmed:
+      return "armed";
+    case runtime::LoopState::kReady:
+      return "ready";
+    case runtime::LoopState::kFaulted:
+      break;
+  }
+  return "faulted";
+}
+
+}  // namespace
+
+Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver)
+    : config_(std::move(config)), driver_(std::move(driver)) {
+  const double ts = config_.sample_time();
+  const models::TransducerModel model = models::load_model(config_.model);
+  auto reconstruction =
+      std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts});
+  const runtime::Controller controller(config_.control, model.actuator, ts);
+  std::string why;
+  if (!driver_->configure({ts}, &why)) throw std::runtime_error("driver: " + why);
+  if (!driver_->activate(&why)) {
+    driver_->deactivate();
+    throw std::runtime_error("driver: " + why);
+  }
+  std::filesystem::create_directories(config_.recorder.directory);
+  recorder_ = std::make_unique<Recorder>(recorder_config(config_, driver_->has_references()),
+                                         fault_name);
+  sink_ = std::make_unique<Sink>(*recorder_);
+  loop_ = std::make_unique<runtime::Loop>(config_.loop_config(), *driver_,
+                                          std::move(reconstruction), controller, sink_.get());
+  runner_ = std::make_unique<runtime::LoopRunner>(
+      *loop_, clock_, static_cast<std::int64_t>(ts * 1e9 + 0.5),
+      runtime::RtOptions{config_.loop.priority, config_.loop.cpu});
+}
+
+Daemon::~Daemon() {
+  if (runner_) runner_->stop();
+  if (driver_) driver_->deactivate();
+  if (recorder_) recorder_->stop();
+  free_retired();
+}
+
+void Daemon::block_signals() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+}
+
+std::optional<runtime::LoopAnswer> Daemon::command(runtime::LoopCommand c,
+                                                   std::chrono::milliseconds timeout) {
+  const std::lock_guard lock(command_mutex_);
+  c.id = ++next_id_;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!loop_->submit(c)) {
+    if (std::chrono::steady_clock::now() > deadline) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  runtime::LoopAnswer a;
+  while (std::chrono::steady_clock::now() <= deadline) {
+    while (loop_->take_answer(a)) {
+      if (a.id == c.id) return a;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  return std::nullopt;
+}
+
+void Daemon::free_retired() {
+  if (!loop_) return;
+  runtime::Retired r;
+  while (loop_->take_retired(r)) {
+    delete r.wave;   // NOLINT(cppcoreguidelines-owning-memory): handed back by the loop
+    delete r.model;  // NOLINT(cppcoreguidelines-owning-memory)
+  }
+}
+
+std::vector<std::string> Daemon::reload() {
+  DriverSectionReader* no_driver = nullptr;
+  ConfigResult next = load_config(config_.source, no_driver);
+  std::vector<std::string> problems;
+  for (const std::string& p : next.problems) {
+    if (p.find("driver.type: no driver registry") == std::string::npos) problems.push_back(p);
+  }
+  if (!problems.empty()) return problems;
+  const DaemonConfig& n = next.config;
+  const auto refuse = [&](bool changed, const char* key) {
+    if (changed) {
+      problems.push_back(config_.source.string() + ": " + key +
+                         ": cannot change while running (restart the service)");
+    }
+  };
+  refuse(n.loop.rate_hz != config_.loop.rate_hz, "loop.rate_hz");
+  refuse(n.loop.priority != config_.loop.priority, "loop.priority");
+  refuse(n.loop.cpu != config_.loop.cpu, "loop.cpu");
+  refuse(n.model != config_.model, "model");
+  refuse(n.driver_type != config_.driver_type, "driver.type");
+  refuse(n.control.mode != config_.control.mode, "control.mode");
+  refuse(n.control.command_min != config_.control.command_min ||
+             n.control.command_max != config_.control.command_max,
+         "control.command_v_per_m");
+  refuse(n.recorder.directory != config_.recorder.directory, "recorder.directory");
+  refuse(n.socket.path != config_.socket.path, "socket.path");
+  if (!problems.empty()) return problems;
+  runtime::LoopCommand c;
+  c.kind = runtime::CommandKind::kGains;
+  c.position = n.control.position.gains;
+  c.force = n.control.force.gains;
+  const auto answer = command(c, std::chrono::milliseconds(500));
+  if (!answer || answer->result != runtime::CommandResult::kDone) {
+    problems.push_back(config_.source.string() + ": control: the loop refused the new gains");
+    return problems;
+  }
+  config_.control.position.gains = n.control.position.gains;
+  config_.control.force.gains = n.control.force.gains;
+  return problems;
+}
+
+void Daemon::notify_status() {
+  const runtime::StatusSnapshot s = loop_->status();
+  std::string faults;
+  for (std::size_t i = 0; i < runtime::kFaultCount; ++i) {
+    if ((s.faults & runtime::bit(static_cast<runtime::Fault>(i))) == 0U) continue;
+    faults += faults.empty() ? "" : ",";
+    faults += runtime::to_string(static_cast<runtime::Fault>(i));
+  }
+  const std::string line = std::string("STATUS=") + state_name(s.state) + ", cycle " +
+                           std::to_string(s.cycle) + ", faults [" + faults + "]" +
+                           (degraded_timing() ? ", degraded timing" : "");
+  static_cast<void>(sd_notify(0, line.c_str()));
+}
+
+void Daemon::write_telemetry() {
+  if (config_.telemetry.prometheus_file.empty()) return;
+  const runtime::StatusSnapshot s = loop_->status();
+  std::string text;
+  const auto gauge = [&](const char* name, const char* help, double v) {
+    text += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " gauge\n" + name +
+            " " + std::to_string(v) + "\n";
+  };
+  gauge("selfsense_loop_state", "0 faulted, 1 ready, 2 armed", static_cast<double>(s.state));
+  gauge("selfsense_loop_cycles", "loop cycles since start", static_cast<double>(s.cycle));
+  gauge("selfsense_loop_faults_latched", "latched fault bits", static_cast<double>(s.faults));
+  gauge("selfsense_loop_overruns", "missed deadlines", static_cast<double>(s.overruns));
+  gauge("selfsense_loop_wake_latency_p99_seconds", "wake-up latency p99",
+        static_cast<double>(s.wake_latency_p99_ns) * 1e-9);
+  gauge("selfsense_loop_cycle_time_p99_seconds", "cycle execution time p99",
+        static_cast<double>(s.cycle_time_p99_ns) * 1e-9);
+  gauge("selfsense_loop_samples_dropped", "samples the recorder could not take",
+        static_cast<double>(s.samples_dropped));
+  try {
+    write_textfile(config_.telemetry.prometheus_file, text);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "selfsensed: telemetry: %s\n", e.what());
+  }
+}
+
+int Daemon::run() {
+  recorder_->start();
+  if (config_.recorder.record_at_start) static_cast<void>(recorder_->start_file());
+  rt_setup_ = runner_->start();
+  for (const std::string& p : rt_setup_.problems) {
+    std::fprintf(stderr, "selfsensed: real-time set-up: %s%s\n", p.c_str(),
+                 config_.loop.allow_degraded_timing ? " (degraded timing allowed)"
+                                                    : " (arming refused)");
+  }
+  static_cast<void>(sd_notify(0, "READY=1"));
+  std::printf("selfsensed: running at %g Hz, driver %s, model %s\n", config_.loop.rate_hz,
+              std::string(driver_->name()).c_str(), config_.model.string().c_str());
+  std::fflush(stdout);
+
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGHUP);
+  std::uint64_t last_progress = runner_->progress();
+  auto last_status = std::chrono::steady_clock::now();
+  auto last_telemetry = last_status;
+  while (!stop_requested_.load()) {
+    const timespec wait{0, 100'000'000};
+    const int sig = sigtimedwait(&set, nullptr, &wait);
+    if (sig == SIGTERM || sig == SIGINT) break;
+    if (sig == SIGHUP) {
+      static_cast<void>(sd_notify(0, "RELOADING=1"));
+      const std::vector<std::string> problems = reload();
+      for (const std::string& p : problems)
+        std::fprintf(stderr, "selfsensed: reload refused: %s\n", p.c_str());
+      if (problems.empty()) std::fprintf(stderr, "selfsensed: reloaded the gains\n");
+      static_cast<void>(sd_notify(0, "READY=1"));
+    }
+    const std::uint64_t progress = runner_->progress();
+    if (progress != last_progress) static_cast<void>(sd_notify(0, "WATCHDOG=1"));
+    last_progress = progress;
+    free_retired();
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_status >= std::chrono::seconds(1)) {
+      notify_status();
+      last_status = now;
+    }
+    if (now - last_telemetry >= std::chrono::duration<double>(config_.telemetry.period_s)) {
+      write_telemetry();
+      last_telemetry = now;
+    }
+  }
+  static_cast<void>(sd_notify(0, "STOPPING=1"));
+  // Safe output first: disarm (the loop writes the safe output from its next cycle), then stop.
+  static_cast<void>(command({0, runtime::CommandKind::kDisarm}, std::chrono::milliseconds(100)));
+  runner_->stop();
+  driver_->deactivate();
+  recorder_->stop();
+  free_retired();
+  std::printf("selfsensed: stopped at cycle %lld\n",
+              static_cast<long long>(loop_->local_status().cycle));
+  return 0;
+}
+
+}  // namespace selfsense::daemon

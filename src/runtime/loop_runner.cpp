@@ -1,0 +1,60 @@
+#include "selfsense/runtime/loop_runner.hpp"
+
+#include "selfsense/runtime/cycle_stats.hpp"
+
+namespace selfsense::runtime {
+
+LoopRunner::LoopRunner(Loop& loop, Clock& clock, std::int64_t period_ns, const RtOptions& rt)
+    : loop_(&loop), clock_(&clock), period_ns_(period_ns), rt_(rt) {}
+
+LoopRunner::~LoopRunner() { stop(); }
+
+RtSetupResult LoopRunner::start() {
+  stop_.store(false);
+  thread_ = std::thread([this] { run(); });
+  std::unique_lock lock(setup_mutex_);
+  setup_cv_.wait(lock, [this] { return setup_done_; });
+  return setup_;
+}
+
+void LoopRunner::stop() {
+  stop_.store(true);
+  if (thread_.joinable()) thread_.join();
+}
+
+void LoopRunner::run() {
+  RtSetupResult setup = setup_realtime(rt_);
+  Pacer pacer(*clock_, period_ns_);
+  CycleStats cycle_stats(period_ns_);
+  StatusSnapshot timing;
+  {
+    const std::lock_guard lock(setup_mutex_);
+    setup_ = std::move(setup);
+    setup_done_ = true;
+  }
+  setup_cv_.notify_all();
+  pacer.start();
+  while (!stop_.load(std::memory_order_relaxed)) {
+    const Pacer::Tick tick = pacer.wait();
+    if (stall_.load(std::memory_order_relaxed)) continue;
+    const std::int64_t begin = clock_->now_ns();
+    loop_->cycle(tick.overrun);
+    cycle_stats.record(clock_->now_ns() - begin);
+    progress_.fetch_add(1, std::memory_order_relaxed);
+    if (tick.cycle % 1000 == 0) {
+      const PacerStats& p = pacer.stats();
+      timing.overruns = p.overruns;
+      timing.missed_periods = p.missed_periods;
+      timing.last_overrun_cycle = p.last_overrun_cycle;
+      timing.wake_latency_p50_ns = p.wake_latency.percentile_ns(0.5);
+      timing.wake_latency_p99_ns = p.wake_latency.percentile_ns(0.99);
+      timing.wake_latency_max_ns = p.wake_latency.max_ns();
+      timing.cycle_time_p50_ns = cycle_stats.percentile_ns(0.5);
+      timing.cycle_time_p99_ns = cycle_stats.percentile_ns(0.99);
+      timing.cycle_time_max_ns = cycle_stats.max_ns();
+      loop_->set_timing(timing);
+    }
+  }
+}
+
+}  // namespace selfsense::runtime
