@@ -14,16 +14,18 @@ set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=common.sh
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
-usage="usage: scripts/vm/run_tests.sh OUT_DIR [--program BINARY]... [--timeout S] TEST.sh..."
+usage="usage: scripts/vm/run_tests.sh OUT_DIR [--program BINARY]... [--file PATH]... [--timeout S] TEST.sh..."
 [ $# -ge 2 ] || vm_die "$usage"
 out=$1
 shift
 programs=()
+files=()
 timeout_s=300
 tests=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --program) programs+=("${2:?$usage}"); shift 2 ;;
+    --file) files+=("${2:?$usage}"); shift 2 ;;
     --timeout) timeout_s=${2:?$usage}; shift 2 ;;
     -*) vm_die "unknown option $1; $usage" ;;
     *) tests+=("$1"); shift ;;
@@ -39,6 +41,11 @@ for test in "${tests[@]}"; do
   install -m 0755 "$test" "$out/payload/tests/"
 done
 [ ${#programs[@]} -eq 0 ] || "$vm_scripts/add_program.sh" "$out/payload" "${programs[@]}"
+# Data files and folders (configurations, unit files) go to /payload/files.
+mkdir -p "$out/payload/files"
+for file in "${files[@]}"; do
+  cp -r "$file" "$out/payload/files/"
+done
 
 status=0
 SELFSENSE_VM_LOG="$out/console.log" SELFSENSE_VM_OUT="$out" \

@@ -206,6 +206,9 @@ void validate(const DaemonConfig& c, Problems& p) {
        {std::pair{"control.position", &k.position}, std::pair{"control.force", &k.force}}) {
     if (!pid->is_valid(ts, &why)) p.add(std::string(name) + ": " + why);
   }
+  if (k.damping.gain > 0.0 && !k.damping.is_valid(ts, &why)) p.add("control.damping: " + why);
+  if (!k.position_shaper.is_valid(ts, &why)) p.add("control.position_shaper: " + why);
+  if (!k.force_shaper.is_valid(ts, &why)) p.add("control.force_shaper: " + why);
   for (std::size_t i = 0; i < c.filters.size(); ++i) {
     const FilterSection& f = c.filters[i];
     const std::string key = "control.filters[" + std::to_string(i) + "]";
@@ -330,6 +333,7 @@ ConfigResult load_config(const std::filesystem::path& path, DriverSectionReader*
     for (std::size_t i = 0; i < c.filters.size() && i < control::FilterChain::kMaxSections; ++i) {
       const FilterSection& f = c.filters[i];
       const double ts = c.sample_time();
+      if (f.frequency_hz >= 0.45 * c.loop.rate_hz) continue;  // reported by validate()
       try {
         if (f.type == "notch") {
           c.control.filters[i] =

@@ -10,10 +10,10 @@
 #include <thread>
 #include <utility>
 
+#include "selfsense/control/wave_generator.hpp"
 #include "selfsense/daemon/prometheus.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/models/runtime_model.hpp"
-#include "selfsense/control/wave_generator.hpp"
 #include "selfsense/runtime/controller.hpp"
 #include "selfsense/runtime/supervisor.hpp"
 
@@ -23,9 +23,7 @@ namespace selfsense::daemon {
 class Daemon::Sink final : public runtime::SampleSink {
  public:
   explicit Sink(Recorder& recorder) : recorder_(&recorder) {}
-  bool push(const runtime::LoopSample& sample) noexcept override {
-    return recorder_->push(sample);
-  }
+  bool push(const runtime::LoopSample& sample) noexcept override { return recorder_->push(sample); }
 
  private:
   Recorder* recorder_;
@@ -69,8 +67,7 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver)
     : config_(std::move(config)), driver_(std::move(driver)) {
   const double ts = config_.sample_time();
   const models::TransducerModel model = models::load_model(config_.model);
-  auto reconstruction =
-      std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts});
+  auto reconstruction = std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts});
   const runtime::Controller controller(config_.control, model.actuator, ts);
   std::string why;
   if (!driver_->configure({ts}, &why)) throw std::runtime_error("driver: " + why);
@@ -79,8 +76,8 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver)
     throw std::runtime_error("driver: " + why);
   }
   std::filesystem::create_directories(config_.recorder.directory);
-  recorder_ = std::make_unique<Recorder>(recorder_config(config_, driver_->has_references()),
-                                         fault_name);
+  recorder_ =
+      std::make_unique<Recorder>(recorder_config(config_, driver_->has_references()), fault_name);
   sink_ = std::make_unique<Sink>(*recorder_);
   loop_ = std::make_unique<runtime::Loop>(config_.loop_config(), *driver_,
                                           std::move(reconstruction), controller, sink_.get());
@@ -218,9 +215,9 @@ int Daemon::run() {
   if (config_.recorder.record_at_start) static_cast<void>(recorder_->start_file());
   rt_setup_ = runner_->start();
   for (const std::string& p : rt_setup_.problems) {
-    std::fprintf(stderr, "selfsensed: real-time set-up: %s%s\n", p.c_str(),
-                 config_.loop.allow_degraded_timing ? " (degraded timing allowed)"
-                                                    : " (arming refused)");
+    std::fprintf(
+        stderr, "selfsensed: real-time set-up: %s%s\n", p.c_str(),
+        config_.loop.allow_degraded_timing ? " (degraded timing allowed)" : " (arming refused)");
   }
   static_cast<void>(sd_notify(0, "READY=1"));
   std::printf("selfsensed: running at %g Hz, driver %s, model %s\n", config_.loop.rate_hz,

@@ -7,7 +7,9 @@ namespace selfsense::runtime {
 LoopRunner::LoopRunner(Loop& loop, Clock& clock, std::int64_t period_ns, const RtOptions& rt)
     : loop_(&loop), clock_(&clock), period_ns_(period_ns), rt_(rt) {}
 
-LoopRunner::~LoopRunner() { stop(); }
+LoopRunner::~LoopRunner() {
+  stop();
+}
 
 RtSetupResult LoopRunner::start() {
   stop_.store(false);

@@ -49,10 +49,10 @@ RtSetupResult setup_realtime(const RtOptions& options) {
   if (fifo == 0) {
     r.fifo = true;
   } else {
-    r.problems.push_back("SCHED_FIFO priority " + std::to_string(options.priority) + ": " +
-                         std::strerror(fifo) + " (needs CAP_SYS_NICE or RLIMIT_RTPRIO >= " +
-                         std::to_string(options.priority) + ", now " +
-                         limit_text(RLIMIT_RTPRIO) + ")");
+    r.problems.push_back(
+        "SCHED_FIFO priority " + std::to_string(options.priority) + ": " + std::strerror(fifo) +
+        " (needs CAP_SYS_NICE or RLIMIT_RTPRIO >= " + std::to_string(options.priority) + ", now " +
+        limit_text(RLIMIT_RTPRIO) + ")");
   }
   if (options.cpu >= 0) {
     cpu_set_t set;

@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   selfsense::drivers::Registry registry;
-  const selfsense::daemon::ConfigResult config = selfsense::daemon::load_config(config_path, &registry);
+  const selfsense::daemon::ConfigResult config =
+      selfsense::daemon::load_config(config_path, &registry);
   if (!config.ok()) {
     for (const std::string& p : config.problems)
       std::fprintf(stderr, "%s\n", p.c_str());

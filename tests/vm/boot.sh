@@ -3,7 +3,7 @@
 # the VM itself did not report (timeout, panic, no payload); each test's own result is checked
 # by its CTest test (systemd_smoke.sh, can_smoke.sh, ...), so one failure does not hide the
 # others. The PROGRAMs (host-built, e.g. the selfsense tool) go in with their libraries.
-#   tests/vm/boot.sh OUT_DIR [PROGRAM...]
+#   tests/vm/boot.sh OUT_DIR [PROGRAM... | --file PATH...]
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
@@ -13,8 +13,14 @@ out=$1
 shift
 vm_require_image
 args=(--timeout 420)
-for program in "$@"; do
-  args+=(--program "$program")
+while [ $# -gt 0 ]; do
+  if [ "$1" = --file ]; then
+    args+=(--file "${2:?--file needs a path}")
+    shift 2
+  else
+    args+=(--program "$1")
+    shift
+  fi
 done
 status=0
 "$vm_repo/scripts/vm/run_tests.sh" "$out" "${args[@]}" "$vm_repo"/tests/vm/payload/*.sh || status=$?

@@ -12,8 +12,8 @@
 namespace selfsense::runtime {
 
 struct RtOptions {
-  int priority{80};                 // SCHED_FIFO 1..99
-  int cpu{-1};                      // -1: no affinity
+  int priority{80};                         // SCHED_FIFO 1..99
+  int cpu{-1};                              // -1: no affinity
   std::size_t prefault_stack{256U << 10U};  // bytes of stack touched
   std::size_t prefault_heap{8U << 20U};     // bytes malloc'ed, touched and freed (kept by glibc)
 };

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Host side of payload/daemon_systemd.sh: selfsensed under systemd as PID 1 (Type=notify,
+# watchdog restart of a frozen daemon, clean stop).
+#   tests/vm/daemon_systemd.sh OUT_DIR   (after tests/vm/boot.sh OUT_DIR ...)
+set -euo pipefail
+# shellcheck source-path=SCRIPTDIR source=lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+
+vm_check_test "${1:?usage: tests/vm/daemon_systemd.sh OUT_DIR}" daemon_systemd \
+  'verify=ok' \
+  'is-active=active' \
+  'nrestarts_while_running=0' \
+  'telemetry=yes' \
+  'nrestarts_after_freeze=[1-9][0-9]*' \
+  'watchdog_timeout_logged=yes' \
+  'is-active_after_restart=active' \
+  'is-active_after_stop=inactive' \
+  'exit_status=0' \
+  'clean_stop_logged=yes'

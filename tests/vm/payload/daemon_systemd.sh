@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# Inside the VM, under systemd as PID 1: selfsensed installed with its unit
+# (systemd/selfsensed.service) and a configuration like config/selfsensed.yaml. Checks that
+# `systemd-analyze verify` accepts the unit, that the service is active once it sent READY=1,
+# that it keeps itself alive through the watchdog, that a frozen daemon gets restarted by the
+# watchdog, and that `systemctl stop` ends it with status 0 after its safe-output shutdown.
+# Prints "name=value" lines that tests/vm/daemon_systemd.sh checks.
+set -euo pipefail
+
+unit=selfsensed.service
+fail() {
+  echo "FAILED: $*"
+  systemctl status --no-pager "$unit" 2>&1 | head -30 || true
+  journalctl -b -u "$unit" --no-pager 2>&1 | tail -30 || true
+  exit 1
+}
+prop() { systemctl show -p "$1" --value "$unit"; }
+
+files=/payload/files
+[ -x /payload/bin/selfsensed ] || fail "/payload/bin/selfsensed missing"
+id selfsense >/dev/null 2>&1 || useradd --system --no-create-home --shell /usr/sbin/nologin selfsense
+mkdir -p /etc/selfsense/models /etc/selfsense/plant
+cp "$files/config/models/sim.yaml" /etc/selfsense/models/
+cp "$files/config/plant/daemon.yaml" /etc/selfsense/plant/
+# Software emulation is far from real time: a 1 kHz loop, degraded timing allowed, overruns
+# tolerated (this test is about systemd, not timing).
+sed -e 's/rate_hz: 10000/rate_hz: 1000/' -e 's/frequency_hz: 2000.0/frequency_hz: 300.0/' \
+  -e 's/allow_degraded_timing: false/allow_degraded_timing: true/' \
+  "$files/config/selfsensed.yaml" >/etc/selfsense/selfsensed.yaml
+selfsense check-config /etc/selfsense/selfsensed.yaml || fail "check-config rejected the configuration"
+
+install -m 0755 /payload/bin/selfsensed /usr/local/bin/selfsensed
+install -m 0644 "$files/selfsensed.service" "/etc/systemd/system/$unit"
+mkdir -p "/etc/systemd/system/$unit.d"
+# The host-built binary's libraries live under /payload/lib.
+cat >"/etc/systemd/system/$unit.d/payload.conf" <<'CFG'
+[Service]
+Environment=LD_LIBRARY_PATH=/payload/lib
+CFG
+if verify=$(systemd-analyze verify "/etc/systemd/system/$unit" 2>&1); then
+  echo "verify=ok"
+else
+  echo "verify=failed"
+  awk '{ print "verify: " $0 }' <<<"$verify"
+fi
+systemd-analyze security --no-pager "$unit" 2>/dev/null | tail -1 | sed 's/^/security: /' || true
+systemctl daemon-reload
+
+systemctl start "$unit" || fail "systemctl start failed"
+state=$(systemctl is-active "$unit" || true)
+echo "is-active=$state"
+[ "$state" = active ] || fail "not active after READY=1"
+sleep 8  # longer than WatchdogSec: the daemon's own pings keep it alive
+echo "nrestarts_while_running=$(prop NRestarts)"
+echo "status_text=$(prop StatusText)"
+[ -s /var/lib/selfsensed/selfsensed.prom ] && echo "telemetry=yes" || echo "telemetry=no"
+
+# A frozen daemon (every thread stopped) sends no WATCHDOG=1: systemd restarts it.
+pid=$(prop MainPID)
+kill -STOP "$pid"
+for _ in $(seq 60); do
+  [ "$(prop NRestarts)" -ge 1 ] && break
+  sleep 0.5
+done
+echo "nrestarts_after_freeze=$(prop NRestarts)"
+for _ in $(seq 40); do
+  [ "$(systemctl is-active "$unit" || true)" = active ] && break
+  sleep 0.5
+done
+echo "is-active_after_restart=$(systemctl is-active "$unit" || true)"
+if journalctl -b -u "$unit" --no-pager | grep -q 'Watchdog timeout'; then
+  echo "watchdog_timeout_logged=yes"
+fi
+
+systemctl stop "$unit" || fail "systemctl stop failed"
+echo "is-active_after_stop=$(systemctl is-active "$unit" || true)"
+echo "exit_status=$(prop ExecMainStatus)"
+if journalctl -b -u "$unit" --no-pager | grep -q 'selfsensed: stopped at cycle'; then
+  echo "clean_stop_logged=yes"
+fi
