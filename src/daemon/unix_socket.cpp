@@ -42,7 +42,12 @@ gid_t group_id(const std::string& name) {
 bool answers(const std::filesystem::path& path) {
   const Fd probe(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!probe.valid()) fail("socket", errno);
-  const sockaddr_un address = address_of(path);
+  sockaddr_un address{};
+  try {
+    address = address_of(path);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error("control socket " + path.string() + ": " + e.what());
+  }
   // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): the sockets API takes sockaddr*.
   if (::connect(probe.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0) {
     return true;
@@ -104,7 +109,7 @@ sockaddr_un address_of(const std::filesystem::path& path) {
   address.sun_family = AF_UNIX;
   const std::string& text = path.native();
   if (text.empty() || text.size() >= sizeof address.sun_path) {
-    throw std::runtime_error("control socket " + text + ": path must have 1 to " +
+    throw std::runtime_error("a socket path has 1 to " +
                              std::to_string(sizeof address.sun_path - 1) + " bytes");
   }
   std::memcpy(&address.sun_path[0], text.data(), text.size());
@@ -123,11 +128,16 @@ ListeningSocket listen_at(const std::filesystem::path& path, const std::string& 
   ListeningSocket out;
   out.fd = Fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0));
   if (!out.fd.valid()) fail("socket", errno);
-  const sockaddr_un address = address_of(temporary);
+  sockaddr_un address{};
+  try {
+    address = address_of(temporary);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error("control socket " + path.string() + ": " + e.what());
+  }
   ::unlink(temporary.c_str());  // left by a crash of this same pid number; ours to remove
   // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): the sockets API takes sockaddr*.
   if (::bind(out.fd.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
-    fail("cannot create control socket " + temporary.string(), errno);
+    fail("cannot create control socket " + path.string(), errno);
   }
   const auto undo = [&temporary](const std::string& what, int error) {
     ::unlink(temporary.c_str());
