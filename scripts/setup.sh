@@ -88,6 +88,17 @@ run_self_sensing() {
     --out "$out/reconstructed.csv"
 }
 
+# The tests under a real kernel and systemd (tests/vm, docs/vm-testing.md): builds the cached
+# VM image unless present (as root; a few minutes once, then instant), then boots it once for
+# every VM test. Needs a configured build directory (the tests are CTest tests).
+run_vm_tests() {
+  local dir=${1:-build}
+  say "vm: image (cached under /var/cache/selfsense-vm)"
+  scripts/vm/image.sh >build/vm-image.log 2>&1 || { tail -40 build/vm-image.log; exit 1; }
+  tail -3 build/vm-image.log
+  run_tests "$dir" -L vm
+}
+
 install_missing
 case "$mode" in
   demo)
@@ -99,12 +110,13 @@ case "$mode" in
   test)
     check_format
     configure_and_build build -DCMAKE_BUILD_TYPE=Release -DSELFSENSE_WERROR=ON
-    run_tests build
+    run_tests build -LE vm
+    run_vm_tests build
     check_tidy
     configure_and_build build-sanitize -DCMAKE_BUILD_TYPE=Debug -DSELFSENSE_WERROR=ON \
       -DSELFSENSE_SANITIZE=address,undefined -DSELFSENSE_BUILD_BENCHMARKS=OFF
     # The accuracy figures are checked in the Release run; under the sanitizers they only cost time.
-    run_tests build-sanitize -LE accuracy
+    run_tests build-sanitize -LE 'accuracy|vm'
     say "all checks passed"
     ;;
   *)

@@ -21,6 +21,7 @@ void add_simulate_command(CLI::App& app);
 void add_reconstruct_command(CLI::App& app);
 void add_feedforward_command(CLI::App& app);
 void add_import_command(CLI::App& app);
+void add_check_config_command(CLI::App& app);
 void add_ctl_command(CLI::App& app);
 
 }  // namespace selfsense::cli

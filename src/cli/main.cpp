@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   selfsense::cli::add_reconstruct_command(app);
   selfsense::cli::add_feedforward_command(app);
   selfsense::cli::add_import_command(app);
+  selfsense::cli::add_check_config_command(app);
   selfsense::cli::add_ctl_command(app);
   try {
     app.parse(argc, argv);

@@ -46,9 +46,13 @@ std::vector<plant::StepOutput> run_paced(const plant::PlantConfig& config,
     out[k] = p.step(inputs[k]);
     static_cast<void>(pacer.wait());
   }
-  std::printf("selfsense plant: paced in real time, %lld overruns (worst %.1f us late)\n",
-              static_cast<long long>(pacer.overruns()),
-              1e-3 * static_cast<double>(pacer.worst_late_ns()));
+  const runtime::LatencyHistogram& wake = pacer.stats().wake_latency;
+  std::printf(
+      "selfsense plant: paced in real time, %lld overruns (worst %.1f us late), wake-up "
+      "latency p99 %.1f us, max %.1f us\n",
+      static_cast<long long>(pacer.overruns()), 1e-3 * static_cast<double>(pacer.worst_late_ns()),
+      1e-3 * static_cast<double>(wake.percentile_ns(0.99)),
+      1e-3 * static_cast<double>(wake.max_ns()));
   return out;
 }
 

@@ -378,6 +378,97 @@ OperatorBasis basis_for(const OperatorSignals& signals, const OperatorStructure&
   return basis;
 }
 
+// Remanent state: the candidate history that best explains the first part of `signals` with
+// the operator `basis` (linear stage, S = identity); the two best grid candidates are refined
+// (rising and falling starts can be close). creep_lags: score with the creep lags of the
+// linear term, or with the plays alone.
+std::vector<double> estimate_history(const OperatorSignals& signals, const OperatorBasis& basis,
+                                     double weight_floor, bool offset, bool creep_lags) {
+  const std::size_t n = signals.input.size();
+  const auto [x_lo, x_hi] = std::minmax_element(signals.input.begin(), signals.input.end());
+  // The start state matters until the input has swept its whole range (wiping-out), so
+  // twice that span decides between candidates.
+  const std::size_t sweep = std::min(n, sweep_length(signals.input));
+  const std::size_t head = std::min(n, std::max<std::size_t>(2 * sweep, 2000));
+  // The other creep columns cost most of the normal equations and say little about where the
+  // plays started. After the sweep every candidate's plays are wiped to the same state, so the
+  // rows of [sweep, head) are accumulated once; the lags still remember the start there, which
+  // the shared rows ignore (it only blurs the score).
+  OperatorBasis scoring = basis;
+  if (!creep_lags) {
+    scoring.creep_rows.clear();
+  } else if (scoring.creep_rows.size() > 1) {
+    scoring.creep_rows.erase(scoring.creep_rows.begin() + 1, scoring.creep_rows.end());
+  }
+  const Fitter scorer(signals, scoring, weight_floor, offset);
+  const GramAccumulator shared = scorer.linear_gram({&signals.input.front(), 1}, sweep, head);
+  const auto residual = [&](const std::vector<double>& h) {
+    GramAccumulator acc = scorer.linear_gram(h, 0, sweep);
+    acc.add(shared);
+    return scorer.solve_linear(acc).rss;
+  };
+  std::vector<std::pair<double, std::vector<double>>> ranked;
+  for (std::vector<double>& candidate : history_candidates(signals.input)) {
+    ranked.emplace_back(residual(candidate), std::move(candidate));
+  }
+  std::sort(ranked.begin(), ranked.end(),
+            [](const auto& l, const auto& r) { return l.first < r.first; });
+  std::vector<double> history{signals.input.front()};
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < std::min<std::size_t>(2, ranked.size()); ++i) {
+    std::vector<double> candidate = ranked[i].second;
+    double rss = ranked[i].first;
+    if (candidate.size() > 1) {
+      std::vector<double> refined =
+          refine_turning_point(candidate, (*x_hi - *x_lo) / 8.0, residual);
+      const double refined_rss = residual(refined);
+      if (refined_rss < rss) {
+        rss = refined_rss;
+        candidate = std::move(refined);
+      }
+    }
+    if (rss < best) {
+      best = rss;
+      history = std::move(candidate);
+    }
+  }
+  return history;
+}
+
+// Linear stage, then (with dead zones) the equation error for S and output-error passes that
+// refit S and the operator in turn, keeping whichever fit explains the data best.
+Fit fit_with_history(Fitter& fitter, const std::vector<double>& history,
+                     const OperatorStructure& structure, std::size_t n) {
+  fitter.set_history(history);
+  Fit best = fitter.linear(history, n);
+  if (structure.dead_zones == 0) return best;
+  // S = identity is a superposition too: the linear stage competes, so dead zones can never
+  // make the fit on these data worse than the structure without them.
+  Fit candidate = fitter.equation_error(best, structure.dead_zones);
+  if (candidate.rss < best.rss) best = candidate;
+  for (std::size_t pass = 0; pass < structure.refinement_passes; ++pass) {
+    candidate = fitter.refit_shape(candidate);
+    if (candidate.rss < best.rss) best = candidate;
+    candidate = fitter.refit_operator(candidate);
+    if (candidate.rss < best.rss) best = candidate;
+  }
+  return best;
+}
+
+// v = S^-1[y - g u - offset]: the output seen through the fitted superposition, on which the
+// operator is linear again.
+std::vector<double> inner_output(const OperatorSignals& signals, const Fit& fit) {
+  const DeadZoneSuperposition inverse = DeadZoneSuperposition(fit.shape).inverse();
+  std::vector<double> v(signals.output.size());
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    double y = signals.output[k] - fit.offset;
+    for (std::size_t u = 0; u < fit.gains.size(); ++u)
+      y -= fit.gains[u] * signals.linear_inputs[u][k];
+    v[k] = inverse.evaluate(y);
+  }
+  return v;
+}
+
 }  // namespace
 
 OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructure& structure) {
@@ -392,65 +483,44 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
   const OperatorBasis basis = basis_for(signals, structure, x_range);
   Fitter fitter(signals, basis, weight_floor, structure.fit_offset);
 
-  // Remanent state: the candidate history that best explains the first part of the data; the
-  // two best grid candidates are refined (rising and falling starts can be close).
+  const bool search = structure.estimate_history && structure.plays > 0;
   std::vector<double> history{signals.input.front()};
-  if (structure.estimate_history && structure.plays > 0) {
-    // The start state matters until the input has swept its whole range (wiping-out), so
-    // twice that span decides between candidates.
-    const std::size_t sweep = std::min(n, sweep_length(signals.input));
-    const std::size_t head = std::min(n, std::max<std::size_t>(2 * sweep, 2000));
-    // Scored with the plays alone: the creep columns cost most of the normal equations and say
-    // little about where the plays started. After the sweep every candidate's plays are wiped
-    // to the same state, so the rows of [sweep, head) are shared: accumulated once.
-    OperatorBasis plays_only = basis;
-    plays_only.creep_rows.clear();
-    const Fitter scorer(signals, plays_only, weight_floor, structure.fit_offset);
-    const GramAccumulator shared = scorer.linear_gram({&signals.input.front(), 1}, sweep, head);
-    const auto residual = [&](const std::vector<double>& h) {
-      GramAccumulator acc = scorer.linear_gram(h, 0, sweep);
-      acc.add(shared);
-      return scorer.solve_linear(acc).rss;
-    };
-    std::vector<std::pair<double, std::vector<double>>> ranked;
-    for (std::vector<double>& candidate : history_candidates(signals.input)) {
-      ranked.emplace_back(residual(candidate), std::move(candidate));
-    }
-    std::sort(ranked.begin(), ranked.end(),
-              [](const auto& l, const auto& r) { return l.first < r.first; });
-    double best = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < std::min<std::size_t>(2, ranked.size()); ++i) {
-      std::vector<double> candidate = ranked[i].second;
-      double rss = ranked[i].first;
-      if (candidate.size() > 1) {
-        std::vector<double> refined = refine_turning_point(candidate, x_range / 8.0, residual);
-        const double refined_rss = residual(refined);
-        if (refined_rss < rss) {
-          rss = refined_rss;
-          candidate = std::move(refined);
-        }
-      }
-      if (rss < best) {
-        best = rss;
-        history = std::move(candidate);
+  if (search) {
+    history = estimate_history(signals, basis, weight_floor, structure.fit_offset, true);
+    if (basis.creep() > 0) {
+      // Scored with the plays alone, the early creep transient is blamed on the plays and the
+      // wrong start can win (2x the least-squares error on a new recording); scored with the
+      // linear creep lags alone, the plant's actuator side got a start with 4 % more residual.
+      // Both are proxies: when they disagree, the whole basis decides on the first part of the
+      // data (where the start shows), at a fraction of the cost of a second full fit.
+      std::vector<double> plays_only =
+          estimate_history(signals, basis, weight_floor, structure.fit_offset, false);
+      if (plays_only != history) {
+        const std::size_t head =
+            std::min(n, std::max<std::size_t>(2 * sweep_length(signals.input), 2000));
+        const auto head_rss = [&](const std::vector<double>& h) {
+          return fitter.solve_linear(fitter.linear_gram(h, 0, head)).rss;
+        };
+        if (head_rss(plays_only) < head_rss(history)) history = std::move(plays_only);
       }
     }
   }
-  fitter.set_history(history);
-
-  // Linear stage, then (with dead zones) the equation error for S and output-error passes
-  // that refit S and the operator in turn, keeping whichever fit explains the data best.
-  Fit fit = fitter.linear(history, n);
-  if (structure.dead_zones > 0) {
-    Fit candidate = fitter.equation_error(fit, structure.dead_zones);
-    Fit best = candidate;
-    for (std::size_t pass = 0; pass < structure.refinement_passes; ++pass) {
-      candidate = fitter.refit_shape(candidate);
-      if (candidate.rss < best.rss) best = candidate;
-      candidate = fitter.refit_operator(candidate);
-      if (candidate.rss < best.rss) best = candidate;
+  Fit fit = fit_with_history(fitter, history, structure, n);
+  if (search && structure.dead_zones > 0 && DeadZoneSuperposition(fit.shape).size() > 0) {
+    // The first search scored the start with S = identity; when the data need dead zones its
+    // model error outweighs the start's signature and a richer basis could pick a worse start
+    // (and fit worse than a smaller one). Search again through the fitted S, where the
+    // operator is linear, and keep the better fit.
+    const std::vector<double> v = inner_output(signals, fit);
+    const OperatorSignals inner{signals.input, {}, v, signals.sample_time};
+    std::vector<double> second = estimate_history(inner, basis, weight_floor, true, true);
+    if (second != history) {
+      Fit refit = fit_with_history(fitter, second, structure, n);
+      if (refit.rss < fit.rss) {
+        fit = std::move(refit);
+        history = std::move(second);
+      }
     }
-    fit = best;
   }
 
   OperatorModel model;

@@ -71,19 +71,24 @@ double initial_input(const TransducerModel& model) noexcept {
 }
 
 // The variants hold the affine kernels by value and the vectorial ones (not movable) by pointer.
-template <typename M>
-decltype(auto) kernel(M& m) noexcept {
-  if constexpr (requires { *m; }) {
-    return *m;
-  } else {
-    return (m);
-  }
+// Dispatched with get_if, not std::visit: visit may throw bad_variant_access, and these run in
+// noexcept real-time code.
+template <typename Affine, typename Vectorial, typename F>
+decltype(auto) dispatch(std::variant<Affine, std::unique_ptr<Vectorial>>& impl, F&& f) noexcept {
+  if (auto* a = std::get_if<Affine>(&impl)) return f(*a);
+  return f(**std::get_if<std::unique_ptr<Vectorial>>(&impl));
+}
+template <typename Affine, typename Vectorial, typename F>
+decltype(auto) dispatch(const std::variant<Affine, std::unique_ptr<Vectorial>>& impl,
+                        F&& f) noexcept {
+  if (const auto* a = std::get_if<Affine>(&impl)) return f(*a);
+  return f(**std::get_if<std::unique_ptr<Vectorial>>(&impl));
 }
 
 template <typename Impl>
 bool save_into(const Impl& impl, const ModelIdentity& identity, SavedState& out) noexcept {
   if (out.values.size() != identity.state_size) return false;
-  std::visit([&](const auto& m) { kernel(m).save_state(out.values); }, impl);
+  dispatch(impl, [&](const auto& m) { m.save_state(out.values); });
   out.identity = identity;
   return true;
 }
@@ -98,13 +103,13 @@ RestoreResult restore_from(Impl& impl, const ModelIdentity& identity,
   if (in.identity.state_size != identity.state_size || in.values.size() != identity.state_size) {
     return RestoreResult::kWrongSize;
   }
-  std::visit([&](auto& m) { kernel(m).restore_state(in.values); }, impl);
+  dispatch(impl, [&](auto& m) { m.restore_state(in.values); });
   return RestoreResult::kOk;
 }
 
 template <typename Impl>
 std::size_t state_size_of(const Impl& impl) noexcept {
-  return std::visit([](const auto& m) { return kernel(m).state_size(); }, impl);
+  return dispatch(impl, [](const auto& m) { return m.state_size(); });
 }
 
 }  // namespace

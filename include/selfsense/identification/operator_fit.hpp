@@ -19,7 +19,8 @@
 //     step for H + K, g, offset (exact on each linear piece of S), each a bounded least-squares
 //     problem again; the fit with the smallest output error is kept;
 //  3. the remanent state before the first sample is chosen among candidate input histories
-//     (a previous extremum at a grid of levels) by the residual on the first part of the data.
+//     (a previous extremum at a grid of levels) by the residual on the first part of the data,
+//     with dead zones a second time through the fitted S^-1 (docs/identification.md).
 // Thresholds follow from the input's range, creep eigenvalues from the sample time and the
 // duration. Not real-time code.
 #pragma once

@@ -19,17 +19,17 @@ enum class ControlMode : std::uint8_t { kPosition = 0, kForce = 1, kOpenLoop = 2
 struct LoopSample {
   static constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
 
-  std::int64_t cycle{0};       // loop cycle index since start
-  double t{0.0};               // [s] since the loop started (sample timestamp of the driver)
-  double e{kNone};             // E [V/m], measured
-  double d{kNone};             // D [C/m^2], measured
-  double t_hat{kNone};         // T_hat [Pa], reconstructed
-  double s_hat{kNone};         // S_hat [-], reconstructed
-  double setpoint{kNone};      // in the mode's unit: S [-] (position), T [Pa] (force)
-  double command{kNone};       // amplifier command as field E [V/m] after limits
-  double s_ref{kNone};         // S [-] from a reference sensor, NaN without one
-  double t_ref{kNone};         // T [Pa] from a reference sensor, NaN without one
-  std::uint32_t faults{0};     // bit set of runtime::Fault (latched)
+  std::int64_t cycle{0};           // loop cycle index since start
+  double t{0.0};                   // [s] since the loop started (sample timestamp of the driver)
+  double e{kNone};                 // E [V/m], measured
+  double d{kNone};                 // D [C/m^2], measured
+  double t_hat{kNone};             // T_hat [Pa], reconstructed
+  double s_hat{kNone};             // S_hat [-], reconstructed
+  double setpoint{kNone};          // in the mode's unit: S [-] (position), T [Pa] (force)
+  double command{kNone};           // amplifier command as field E [V/m] after limits
+  double s_ref{kNone};             // S [-] from a reference sensor, NaN without one
+  double t_ref{kNone};             // T [Pa] from a reference sensor, NaN without one
+  std::uint32_t faults{0};         // bit set of runtime::Fault (latched)
   std::uint16_t driver_status{0};  // the driver's per-sample status word
   LoopState state{LoopState::kFaulted};
   ControlMode mode{ControlMode::kPosition};

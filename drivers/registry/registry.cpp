@@ -1,0 +1,67 @@
+#include "registry/registry.hpp"
+
+#include <exception>
+#include <stdexcept>
+
+#include "selfsense/io/yaml_map.hpp"
+#include "selfsense/plant_io/plant_yaml.hpp"
+#include "sim/simulated_transducer.hpp"
+
+namespace selfsense::drivers {
+namespace {
+
+void read_simulated(io::YamlMap& driver, const daemon::DaemonConfig& config,
+                    plant::PlantConfig& plant_config, std::vector<std::string>& problems) {
+  const std::filesystem::path path =
+      config.source.parent_path() / driver.required<std::string>("plant");
+  try {
+    plant_config = plant::load_plant_file(path).plant;
+  } catch (const std::exception& e) {
+    problems.push_back(driver.locate(std::string("driver.plant: ") + e.what()));
+    return;
+  }
+  const double ratio = plant_config.sample_rate_hz / config.loop.rate_hz;
+  if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio || ratio < 1.0) {
+    problems.push_back(driver.locate(
+        "driver.plant: the plant's sample_rate_hz " + std::to_string(plant_config.sample_rate_hz) +
+        " is not a whole multiple of loop.rate_hz " + std::to_string(config.loop.rate_hz) +
+        " (the loop rate must divide the ADC rate)"));
+  }
+  if (plant_config.amplifier.enabled) {
+    const double h = plant_config.geometry.layer_thickness_m;
+    const double lo = plant_config.amplifier.voltage_min_v / h;
+    const double hi = plant_config.amplifier.voltage_max_v / h;
+    if (config.control.command_min < lo || config.control.command_max > hi) {
+      problems.push_back(driver.locate(
+          "control.command_v_per_m: [" + std::to_string(config.control.command_min) + ", " +
+          std::to_string(config.control.command_max) + "] must lie inside the amplifier's range [" +
+          std::to_string(lo) + ", " + std::to_string(hi) + "] V/m"));
+    }
+  }
+}
+
+}  // namespace
+
+std::string driver_types() {
+  return "simulated";
+}
+
+void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
+                    std::vector<std::string>& problems) {
+  type_ = config.driver_type;
+  const std::size_t before = problems.size();
+  if (type_ == "simulated") {
+    read_simulated(driver, config, plant_, problems);
+  } else {
+    problems.push_back(
+        driver.locate("driver.type: '" + type_ + "' is not one of " + driver_types()));
+  }
+  ok_ = problems.size() == before;
+}
+
+std::unique_ptr<runtime::Driver> Registry::create() const {
+  if (!ok_) throw std::logic_error("driver registry: no valid driver section was read");
+  return std::make_unique<SimulatedTransducer>(plant_);
+}
+
+}  // namespace selfsense::drivers

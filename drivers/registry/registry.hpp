@@ -1,0 +1,35 @@
+// The table of drivers the daemon can build, chosen by `driver.type` in its configuration at
+// run time (no rebuild, no preprocessor selection). Reads each driver's own keys (strictly,
+// problems named with file, line and key) and builds the driver. Not real-time code.
+//
+//   type: simulated     the simulated transducer (drivers/sim)
+//     plant: PATH       a plant configuration (config/plant/), relative to the daemon's file
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "selfsense/daemon/config.hpp"
+#include "selfsense/plant/config.hpp"
+#include "selfsense/runtime/driver.hpp"
+
+namespace selfsense::drivers {
+
+// Every driver type, for messages: "simulated".
+[[nodiscard]] std::string driver_types();
+
+class Registry final : public daemon::DriverSectionReader {
+ public:
+  void read(io::YamlMap& driver, const daemon::DaemonConfig& config,
+            std::vector<std::string>& problems) override;
+  // The driver read last; throws std::logic_error if read() found problems or was not called.
+  [[nodiscard]] std::unique_ptr<runtime::Driver> create() const;
+
+ private:
+  std::string type_{};
+  bool ok_{false};
+  plant::PlantConfig plant_{};
+};
+
+}  // namespace selfsense::drivers

@@ -1,0 +1,99 @@
+#include "sim/simulated_transducer.hpp"
+
+#include <cmath>
+#include <utility>
+
+#include "selfsense/plant/status.hpp"
+
+namespace selfsense::drivers {
+
+SimulatedTransducer::SimulatedTransducer(plant::PlantConfig config) : config_(std::move(config)) {}
+
+bool SimulatedTransducer::configure(const runtime::DriverSetup& setup, std::string* why) {
+  const double ratio = config_.sample_rate_hz * setup.sample_time;
+  const double whole = std::round(ratio);
+  if (!(whole >= 1.0) || std::abs(ratio - whole) > 1e-9 * whole) {
+    if (why != nullptr) {
+      *why = "driver.plant.sample_rate_hz: " + std::to_string(config_.sample_rate_hz) +
+             " Hz is not a whole multiple of the loop rate " +
+             std::to_string(1.0 / setup.sample_time) + " Hz";
+    }
+    return false;
+  }
+  std::string invalid;
+  if (!config_.is_valid(&invalid)) {
+    if (why != nullptr) *why = "driver." + invalid;
+    return false;
+  }
+  substeps_ = static_cast<int>(whole);
+  sample_time_ = setup.sample_time;
+  plant_ = std::make_unique<plant::Plant>(config_);
+  return true;
+}
+
+bool SimulatedTransducer::activate(std::string* why) {
+  if (!plant_) {
+    if (why != nullptr) *why = "simulated transducer: activate() before configure()";
+    return false;
+  }
+  active_ = true;
+  command_ = 0.0;
+  return true;
+}
+
+runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexcept {
+  if (!active_) return runtime::DriverStatus::kNotActive;
+  ++counters_.reads;
+  const plant::StepInput input{command_, force_n_.load(std::memory_order_relaxed), 25.0};
+  plant::StepOutput o{};
+  std::uint32_t status = 0;
+  for (int i = 0; i < substeps_; ++i) {
+    o = plant_->step(input);
+    status |= o.status;
+  }
+  ++cycles_;
+  out.e = o.e_meas_v_per_m;
+  out.d = o.d_meas_c_per_m2;
+  out.s_ref = o.s;
+  out.t_ref = o.t_pa;
+  out.timestamp_ns = static_cast<std::int64_t>(std::llround(o.t_s * 1e9));
+  out.device_status = static_cast<std::uint16_t>(o.status & 0xffffU);
+  if ((o.status & plant::kAmplifierFault) != 0U) {
+    ++counters_.device_faults;
+    return runtime::DriverStatus::kDeviceFault;
+  }
+  if ((o.status & (plant::kStuckAdc | plant::kMissedDataReady)) != 0U) {
+    ++counters_.stale;
+    return runtime::DriverStatus::kStale;
+  }
+  if ((o.status & (plant::kNanSample | plant::kOutOfRange | plant::kSensorDisconnect)) != 0U) {
+    ++counters_.bad_data;
+    return runtime::DriverStatus::kBadData;
+  }
+  return runtime::DriverStatus::kOk;
+}
+
+runtime::DriverStatus SimulatedTransducer::write(const runtime::OutputCommand& command) noexcept {
+  if (!active_) return runtime::DriverStatus::kNotActive;
+  ++counters_.writes;
+  command_ = std::isfinite(command.e) ? command.e : 0.0;
+  return runtime::DriverStatus::kOk;
+}
+
+void SimulatedTransducer::deactivate() noexcept {
+  command_ = 0.0;
+  active_ = false;
+}
+
+runtime::DriverCounters SimulatedTransducer::counters() const noexcept {
+  return counters_;
+}
+
+bool SimulatedTransducer::inject(plant::FaultKind kind, plant::Channel channel,
+                                 std::int64_t after_cycles, std::int64_t cycles) noexcept {
+  if (!plant_) return false;
+  const std::int64_t now = plant_->save().sample;
+  return plant_->inject(kind, channel, now + after_cycles * substeps_, cycles * substeps_);
+}
+
+}  // namespace selfsense::drivers

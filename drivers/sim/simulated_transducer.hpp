@@ -1,0 +1,66 @@
+// The simulated transducer (selfsense::plant) as a driver of the loop: the first
+// implementation of runtime::Driver and the one CI runs, with the plant's fault-injection API
+// behind it.
+//
+// Timing: the plant runs `substeps` samples per loop cycle (its rate divided by the loop's, an
+// integer: the loop rate must divide the ADC rate). write(E) holds E for the next cycle (zero
+// order hold, like a DAC); read() advances the plant by one cycle with the held command and the
+// external force, and returns the last substep's measured E and D, with the true S and T as
+// reference channels.
+//
+// Faults: a plant status bit becomes a driver status: stuck ADC and missed data-ready -> kStale,
+// NaN, out-of-range and disconnected channels -> kBadData (the values are passed on too, so the
+// loop's own checks see them), amplifier fault line -> kDeviceFault.
+//
+// read(), write(), inject(), set_external_force() are real-time safe.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "selfsense/plant/config.hpp"
+#include "selfsense/plant/plant.hpp"
+#include "selfsense/runtime/driver.hpp"
+
+namespace selfsense::drivers {
+
+class SimulatedTransducer final : public runtime::Driver {
+ public:
+  explicit SimulatedTransducer(plant::PlantConfig config);
+
+  [[nodiscard]] std::string_view name() const noexcept override { return "simulated"; }
+  bool configure(const runtime::DriverSetup& setup, std::string* why) override;
+  bool activate(std::string* why) override;
+  runtime::DriverStatus read(runtime::InputSample& out) noexcept override;
+  runtime::DriverStatus write(const runtime::OutputCommand& command) noexcept override;
+  void deactivate() noexcept override;
+  [[nodiscard]] bool has_references() const noexcept override { return true; }
+  [[nodiscard]] runtime::DriverCounters counters() const noexcept override;
+
+  // Test bench: an external force [N] on the stack (a load step, an impulse), any thread.
+  void set_external_force(double newtons) noexcept {
+    force_n_.store(newtons, std::memory_order_relaxed);
+  }
+  // Fault injection, starting `after_cycles` loop cycles from now, lasting `cycles` cycles.
+  bool inject(plant::FaultKind kind, plant::Channel channel, std::int64_t after_cycles,
+              std::int64_t cycles) noexcept;
+
+  [[nodiscard]] const plant::Plant& plant() const noexcept { return *plant_; }
+  [[nodiscard]] double command() const noexcept { return command_; }
+  [[nodiscard]] int substeps() const noexcept { return substeps_; }
+
+ private:
+  plant::PlantConfig config_;
+  std::unique_ptr<plant::Plant> plant_{};
+  int substeps_{1};
+  double sample_time_{0.0};
+  bool active_{false};
+  double command_{0.0};
+  std::int64_t cycles_{0};
+  std::atomic<double> force_n_{0.0};
+  runtime::DriverCounters counters_{};
+};
+
+}  // namespace selfsense::drivers

@@ -1,0 +1,148 @@
+// The daemon's configuration: one YAML file, plain structs with defaults, loaded strictly
+// (unknown keys and wrong types are errors naming file, line and key path) and validated with
+// every problem named (`selfsense check-config`). Not real-time code.
+//
+//   selfsensed: 1                       # format version
+//   loop: {rate_hz, priority, cpu, allow_degraded_timing, status_period_cycles}
+//   model: PATH                         # a model file from `selfsense identify` (relative paths
+//                                       # are relative to this file)
+//   driver: {type: simulated, plant: PATH, ...}     # the driver's own keys, see drivers/
+//   control:
+//     mode: position | force | open-loop | damping
+//     feedforward: true
+//     command_v_per_m: [min, max]       # amplifier command range as field E
+//     force_direction: -1               # sign of dT/dE of the mount
+//     position: {kp, ki, kd, derivative_filter_s, setpoint_weight, tracking_time_s}
+//     force: {...}                      # the same keys; E per Pa
+//     position_shaper: {slew_per_s, filter: none|first-order|second-order, time_constant_s}
+//     force_shaper: {...}
+//     damping: {law: ppf|velocity, gain, frequency_hz, damping, dc_block_hz}
+//     filters: [{type: notch, frequency_hz, quality, bandwidth_hz, depth_db},
+//               {type: low-pass, frequency_hz, quality}, ...]        # at most 4
+//   safety:
+//     safe_output: zero | hold
+//     safe_value_v_per_m: 0
+//     strain_range: [min, max]          # physical range of S_hat
+//     stress_range_pa: [min, max]       # of T_hat
+//     setpoint_strain: [min, max]       # accepted setpoints in position, open-loop, damping
+//     setpoint_stress_pa: [min, max]    # in force
+//     overrun: {consecutive, within_count, window_cycles}
+//     watchdog_s: 0                     # 0: off
+//   recorder: {directory, rotate_bytes, flush_ms, ring_capacity, flight_recorder_s,
+//              record_at_start}
+//   socket: {path, group, max_clients}
+//   telemetry: {prometheus_file, period_s}
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "selfsense/control/filter_design.hpp"
+#include "selfsense/io/yaml_map.hpp"
+#include "selfsense/runtime/controller.hpp"
+#include "selfsense/runtime/loop.hpp"
+
+namespace selfsense::daemon {
+
+inline constexpr int kConfigFormatVersion = 1;
+
+struct LoopSection {
+  double rate_hz{10000.0};
+  int priority{80};  // SCHED_FIFO 1..99
+  int cpu{-1};       // affinity; -1: any
+  bool allow_degraded_timing{false};
+  std::uint32_t status_period_cycles{100};
+};
+
+struct FilterSection {
+  std::string type{};  // notch | low-pass | high-pass | low-pass-1 | high-pass-1
+  double frequency_hz{0.0};
+  double quality{0.0};
+  double bandwidth_hz{0.0};
+  double depth_db{40.0};
+};
+
+struct Range {
+  double min{0.0};
+  double max{0.0};
+};
+
+struct SafetySection {
+  runtime::SafeOutput safe_output{runtime::SafeOutput::kZero};
+  double safe_value_v_per_m{0.0};
+  Range strain{-2e-3, 3e-3};
+  Range stress_pa{-1e8, 1e8};
+  Range setpoint_strain{-1e-4, 1.5e-3};
+  Range setpoint_stress_pa{-3e7, 1e7};
+  runtime::OverrunPolicy overrun{};
+  double watchdog_s{0.0};
+};
+
+struct RecorderSection {
+  std::filesystem::path directory{"/var/lib/selfsensed"};
+  std::uint64_t rotate_bytes{256ULL << 20U};
+  double flush_ms{200.0};
+  std::size_t ring_capacity{1U << 18U};  // about 13 s at 20 kHz
+  double flight_recorder_s{5.0};
+  bool record_at_start{false};
+};
+
+struct SocketSection {
+  std::filesystem::path path{"/run/selfsensed/control.sock"};
+  std::string group{};  // empty: the daemon's own group
+  int max_clients{16};
+};
+
+struct TelemetrySection {
+  std::filesystem::path prometheus_file{};  // empty: none
+  double period_s{1.0};
+};
+
+struct DaemonConfig {
+  std::filesystem::path source{};  // the file it was read from
+  LoopSection loop{};
+  std::filesystem::path model{};
+  std::string driver_type{};
+  runtime::ControllerConfig control{};
+  std::vector<FilterSection> filters{};
+  SafetySection safety{};
+  RecorderSection recorder{};
+  SocketSection socket{};
+  TelemetrySection telemetry{};
+
+  [[nodiscard]] double sample_time() const noexcept { return 1.0 / loop.rate_hz; }
+  // The loop's configuration (sample time, safety) from these sections.
+  [[nodiscard]] runtime::LoopConfig loop_config() const;
+};
+
+// A loaded configuration and the problems found in it. A structural problem (YAML syntax,
+// unknown key, wrong type) ends the loading; every value and cross-field problem is collected.
+struct ConfigResult {
+  DaemonConfig config{};
+  std::vector<std::string> problems{};  // "FILE:LINE: KEY.PATH: what is wrong"
+  [[nodiscard]] bool ok() const noexcept { return problems.empty(); }
+};
+
+// The driver's own section is read by the driver registry (drivers/registry.hpp), given the
+// open map: it reads its keys and returns its problems.
+class DriverSectionReader {
+ public:
+  DriverSectionReader() = default;
+  DriverSectionReader(const DriverSectionReader&) = delete;
+  DriverSectionReader& operator=(const DriverSectionReader&) = delete;
+  DriverSectionReader(DriverSectionReader&&) = delete;
+  DriverSectionReader& operator=(DriverSectionReader&&) = delete;
+  virtual ~DriverSectionReader() = default;
+  // Reads `driver` (type already taken) and appends problems located with driver.locate().
+  virtual void read(io::YamlMap& driver, const DaemonConfig& config,
+                    std::vector<std::string>& problems) = 0;
+};
+
+// Never throws for a bad file: every problem goes into the result.
+[[nodiscard]] ConfigResult load_config(const std::filesystem::path& path,
+                                       DriverSectionReader* driver_reader);
+
+}  // namespace selfsense::daemon

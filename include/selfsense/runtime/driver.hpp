@@ -1,0 +1,87 @@
+// The narrow seam between the loop and the hardware: one driver gives the loop its inputs (E
+// and D, and reference S, T where a bench sensor exists) and takes the amplifier command.
+// The simulated transducer (drivers/sim) is the first implementation; SPI, Modbus and CAN
+// drivers stand behind the same interface.
+//
+// Lifecycle, each step once, in order, from the daemon's main thread (not real-time):
+//   configure(setup)   check the setup against the device, allocate; an error names the cause
+//   activate()         open the device, start its threads; the output is at its safe value
+//   read() / write()   once per loop cycle, on the real-time thread
+//   deactivate()       safe output, stop threads, close; also called after a failed activate
+// read() and write() are real-time safe: noexcept, no allocation, no lock, no blocking I/O
+// (bus drivers move blocking I/O to their own threads and hand samples over lock-free), and
+// report through a status code, never an exception.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+
+namespace selfsense::runtime {
+
+enum class DriverStatus : std::uint8_t {
+  kOk = 0,
+  kTimeout = 1,       // no sample in time
+  kStale = 2,         // the sample repeats the last one (missed data-ready, stuck converter)
+  kBadData = 3,       // CRC error, NaN or out-of-range raw value
+  kDeviceFault = 4,   // the device reports a fault (amplifier fault line, converter error)
+  kDisconnected = 5,  // no link to the device
+  kNotActive = 6,     // called outside activate() .. deactivate()
+};
+[[nodiscard]] std::string_view to_string(DriverStatus s) noexcept;
+
+struct InputSample {
+  static constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  double e{kNone};                 // E [V/m]
+  double d{kNone};                 // D [C/m^2]
+  double s_ref{kNone};             // S [-] from a reference sensor, NaN without one
+  double t_ref{kNone};             // T [Pa] from a reference sensor, NaN without one
+  std::int64_t timestamp_ns{0};    // sampling instant on the loop's clock
+  std::uint16_t device_status{0};  // the device's own status bits, for the recording
+};
+
+struct OutputCommand {
+  double e{0.0};  // commanded field E [V/m] (the driver scales to its DAC or register)
+};
+
+struct DriverSetup {
+  double sample_time{0.0};  // [s] of the loop
+};
+
+// Counters a driver keeps (read from any thread; the owning driver writes them).
+struct DriverCounters {
+  std::uint64_t reads{0};
+  std::uint64_t writes{0};
+  std::uint64_t errors{0};
+  std::uint64_t timeouts{0};
+  std::uint64_t stale{0};
+  std::uint64_t bad_data{0};
+  std::uint64_t retries{0};
+  std::uint64_t reconnects{0};
+  std::uint64_t device_faults{0};
+};
+
+class Driver {
+ public:
+  Driver() = default;
+  Driver(const Driver&) = delete;
+  Driver& operator=(const Driver&) = delete;
+  Driver(Driver&&) = delete;
+  Driver& operator=(Driver&&) = delete;
+  virtual ~Driver() = default;
+
+  [[nodiscard]] virtual std::string_view name() const noexcept = 0;
+  // False with *why naming the problem (a setting, the device's answer).
+  virtual bool configure(const DriverSetup& setup, std::string* why) = 0;
+  virtual bool activate(std::string* why) = 0;
+  virtual DriverStatus read(InputSample& out) noexcept = 0;
+  virtual DriverStatus write(const OutputCommand& command) noexcept = 0;
+  virtual void deactivate() noexcept = 0;
+
+  // Whether read() fills s_ref and t_ref.
+  [[nodiscard]] virtual bool has_references() const noexcept { return false; }
+  [[nodiscard]] virtual DriverCounters counters() const noexcept = 0;
+};
+
+}  // namespace selfsense::runtime

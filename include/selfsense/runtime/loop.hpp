@@ -1,0 +1,126 @@
+// The real-time loop, one explicit cycle:
+//
+//   commands -> read E, D (driver) -> reconstruct T_hat, S_hat (model) -> supervise
+//            -> setpoint (hold, socket, wave) -> control -> write the command (driver) -> record
+//
+// Safety (supervisor.hpp): a driver error, timeout or stale sample, a rejected or failed
+// reconstruction, an estimate outside the configured physical range, the overrun policy and the
+// setpoint watchdog each latch a fault; the command written in the same cycle is then the safe
+// output (zero or hold, configured). While faulted or ready the safe output is written too.
+//
+// Threads: cycle() runs on the real-time thread only. submit(), take_answer(), take_retired()
+// and status() are for one control thread (single producer / single consumer rings), status()
+// for any thread. cycle() is real-time safe: no allocation, lock, exception, blocking call or
+// I/O besides the driver's non-blocking read and write (tests/runtime/loop_realtime_test.cpp).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "selfsense/control/wave_generator.hpp"
+#include "selfsense/models/runtime_model.hpp"
+#include "selfsense/runtime/controller.hpp"
+#include "selfsense/runtime/driver.hpp"
+#include "selfsense/runtime/latest_value.hpp"
+#include "selfsense/runtime/loop_command.hpp"
+#include "selfsense/runtime/loop_sample.hpp"
+#include "selfsense/runtime/spsc_ring.hpp"
+#include "selfsense/runtime/status_snapshot.hpp"
+#include "selfsense/runtime/supervisor.hpp"
+
+namespace selfsense::runtime {
+
+enum class SafeOutput : std::uint8_t { kZero, kHold };
+
+struct LoopConfig {
+  double sample_time{1e-4};  // [s]
+  SafeOutput safe_output{SafeOutput::kZero};
+  double safe_value{0.0};    // E [V/m] written by kZero ("zero" field, or a configured bias)
+  double strain_min{-2e-3};  // physical range of S_hat [-]; outside: kEstimateOutOfRange
+  double strain_max{3e-3};
+  double stress_min{-1e8};  // [Pa]
+  double stress_max{1e8};
+  OverrunPolicy overrun{};
+  double watchdog_s{0.0};            // armed on socket setpoints: fault if none within it; 0: off
+  std::uint32_t status_period{100};  // cycles between status snapshots
+  std::size_t command_capacity{64};
+
+  [[nodiscard]] bool is_valid(std::string* why) const;
+};
+
+// Where recorded samples go (the recorder's ring). Real-time safe: never blocks.
+class SampleSink {
+ public:
+  SampleSink() = default;
+  SampleSink(const SampleSink&) = delete;
+  SampleSink& operator=(const SampleSink&) = delete;
+  SampleSink(SampleSink&&) = delete;
+  SampleSink& operator=(SampleSink&&) = delete;
+  virtual ~SampleSink() = default;
+  // False when the sample could not be taken (counted by the loop as dropped).
+  virtual bool push(const LoopSample& sample) noexcept = 0;
+};
+
+class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members in reading order
+ public:
+  // Throws std::invalid_argument on an invalid configuration. The driver must be active before
+  // the first cycle; the sink may be null (nothing recorded).
+  Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Reconstruction> model,
+       const Controller& controller, SampleSink* sink);
+  Loop(const Loop&) = delete;
+  Loop& operator=(const Loop&) = delete;
+  Loop(Loop&&) = delete;
+  Loop& operator=(Loop&&) = delete;
+  ~Loop();
+
+  // One cycle. overrun: the pacer found this cycle's deadline already past.
+  void cycle(bool overrun) noexcept;
+
+  // Control thread.
+  bool submit(const LoopCommand& command) noexcept { return commands_.try_push(command); }
+  bool take_answer(LoopAnswer& out) noexcept { return answers_.try_pop(out); }
+  bool take_retired(Retired& out) noexcept { return retired_.try_pop(out); }
+  // Any thread: the newest published snapshot.
+  [[nodiscard]] StatusSnapshot status() const noexcept { return published_.read(); }
+  // The loop thread's own view (tests, the runner that adds timing).
+  [[nodiscard]] const StatusSnapshot& local_status() const noexcept { return status_; }
+  // Timing figures from the runner, published with the next snapshot.
+  void set_timing(const StatusSnapshot& timing) noexcept;
+
+  [[nodiscard]] const Supervisor& supervisor() const noexcept { return supervisor_; }
+  [[nodiscard]] const Controller& controller() const noexcept { return controller_; }
+  [[nodiscard]] const LoopConfig& config() const noexcept { return config_; }
+
+ private:
+  void handle(const LoopCommand& c) noexcept;
+  void answer(const LoopCommand& c, CommandResult r) noexcept;
+  [[nodiscard]] double safe_command() const noexcept;
+  [[nodiscard]] double setpoint() noexcept;
+
+  LoopConfig config_;
+  Driver* driver_;
+  std::unique_ptr<models::Reconstruction> model_;
+  Controller controller_;
+  SampleSink* sink_;
+  Supervisor supervisor_;
+  SpscRing<LoopCommand> commands_;
+  SpscRing<LoopAnswer> answers_;
+  SpscRing<Retired> retired_;
+  LatestValue<StatusSnapshot> published_{};
+  StatusSnapshot status_{};
+
+  std::unique_ptr<control::WaveGenerator> wave_{};
+  bool wave_running_{false};
+  double last_wave_value_{0.0};
+  double hold_setpoint_{0.0};
+  double command_{0.0};  // last written command E [V/m]
+  std::int64_t cycle_{0};
+  std::int64_t last_feed_{0};  // cycle of the last setpoint or heartbeat
+  double s_hat_{0.0};
+  double t_hat_{0.0};
+  bool estimate_valid_{false};
+  std::uint32_t active_causes_{0};  // faults seen in the current cycle
+};
+
+}  // namespace selfsense::runtime

@@ -1,0 +1,65 @@
+// Requests from the control thread to the real-time loop, and the loop's answers. Plain values
+// carried through lock-free rings (spsc_ring.hpp). Objects that take allocation to build (a
+// wave generator with its table, a re-identified model) are built on the control thread and
+// handed over by pointer; the loop gives the ones it replaced back through the `retired` ring so
+// they are freed off the real-time thread.
+#pragma once
+
+#include <cstdint>
+
+#include "selfsense/control/pid.hpp"
+#include "selfsense/runtime/loop_sample.hpp"
+
+namespace selfsense::control {
+class WaveGenerator;
+}
+namespace selfsense::models {
+class Reconstruction;
+}
+
+namespace selfsense::runtime {
+
+enum class CommandKind : std::uint8_t {
+  kArm,
+  kDisarm,
+  kReset,
+  kSetpoint,   // value: the mode's quantity; stops a running wave
+  kHeartbeat,  // feeds the setpoint watchdog without changing anything
+  kMode,       // mode
+  kWave,       // wave (ownership passes to the loop)
+  kStopWave,   // hold the wave's last value
+  kGains,      // position, force
+  kSwapModel,  // model (ownership passes to the loop; its memory is carried over)
+};
+
+struct LoopCommand {
+  std::uint64_t id{0};
+  CommandKind kind{CommandKind::kHeartbeat};
+  double value{0.0};
+  ControlMode mode{ControlMode::kPosition};
+  control::WaveGenerator* wave{nullptr};
+  models::Reconstruction* model{nullptr};
+  control::Pid::Gains position{};
+  control::Pid::Gains force{};
+};
+
+enum class CommandResult : std::uint8_t {
+  kDone,
+  kRefusedState,  // not allowed in the current state (arm while faulted, mode while armed...)
+  kRefusedCause,  // reset while a fault cause is still active
+  kInvalid,       // rejected by the control law (gains)
+};
+
+struct LoopAnswer {
+  std::uint64_t id{0};
+  CommandResult result{CommandResult::kDone};
+  LoopState state{LoopState::kFaulted};
+};
+
+// Something the loop no longer uses, to be freed off the real-time thread.
+struct Retired {
+  control::WaveGenerator* wave{nullptr};
+  models::Reconstruction* model{nullptr};
+};
+
+}  // namespace selfsense::runtime

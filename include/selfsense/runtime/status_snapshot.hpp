@@ -1,0 +1,42 @@
+// What the loop publishes for the status request, the telemetry and the systemd STATUS= line:
+// a plain value copied out every `status_period` cycles (LatestValue in spsc_ring.hpp), so
+// readers on other threads never wait for, nor stall, the loop.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "selfsense/models/sample_status.hpp"
+#include "selfsense/runtime/driver.hpp"
+#include "selfsense/runtime/loop_sample.hpp"
+#include "selfsense/runtime/supervisor.hpp"
+
+namespace selfsense::runtime {
+
+struct StatusSnapshot {
+  std::int64_t cycle{0};
+  LoopSample last{};
+  LoopState state{LoopState::kFaulted};
+  ControlMode mode{ControlMode::kPosition};
+  std::uint32_t faults{0};  // latched bits
+  std::array<FaultRecord, kFaultCount> fault_records{};
+  std::array<std::uint64_t, models::kSampleStatusCount> estimate_status{};
+  DriverCounters driver{};
+  std::uint64_t commands{0};
+  std::uint64_t saturations{0};
+  std::uint64_t samples_dropped{0};  // the sample sink (recorder) refused them
+  std::uint64_t model_swaps{0};
+  bool wave_running{false};
+  // Timing, filled by the thread that runs the loop (runtime/loop_runner).
+  std::int64_t overruns{0};
+  std::int64_t missed_periods{0};
+  std::int64_t wake_latency_p50_ns{0};
+  std::int64_t wake_latency_p99_ns{0};
+  std::int64_t wake_latency_max_ns{0};
+  std::int64_t cycle_time_p50_ns{0};
+  std::int64_t cycle_time_p99_ns{0};
+  std::int64_t cycle_time_max_ns{0};
+  std::int64_t last_overrun_cycle{-1};
+};
+
+}  // namespace selfsense::runtime

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Entry point of a multi-test payload (copied to /payload/run.sh by run_tests.sh): runs every
+# /payload/tests/*.sh in turn, one VM boot for all of them, and reports each on its own:
+#   SELFSENSE-VM: TEST name START
+#   SELFSENSE-VM: [name] <each line the test prints>
+#   SELFSENSE-VM: TEST name PASS|FAIL rc=N 1.23s
+# Exits with the number of failed tests (at most 100).
+set -euo pipefail
+
+export PATH=/payload/bin:$PATH
+export LD_LIBRARY_PATH=/payload/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+# Each test gets its own limit, well inside run.sh's limit for the whole boot.
+per_test_timeout=120
+
+now() { cut -d' ' -f1 /proc/uptime; }
+
+failed=0
+for test in /payload/tests/*.sh; do
+  [ -f "$test" ] || continue
+  name=$(basename "$test" .sh)
+  echo "SELFSENSE-VM: TEST $name START"
+  begin=$(now)
+  # A test that hangs is stopped and fails instead of using up the whole VM's time.
+  set +e
+  timeout "$per_test_timeout" bash "$test" 2>&1 | sed -u "s/^/SELFSENSE-VM: [$name] /"
+  rc=${PIPESTATUS[0]}
+  set -e
+  seconds=$(awk -v a="$begin" -v b="$(now)" 'BEGIN { printf "%.2f", b - a }')
+  if [ "$rc" -eq 0 ]; then
+    echo "SELFSENSE-VM: TEST $name PASS rc=0 ${seconds}s"
+  else
+    echo "SELFSENSE-VM: TEST $name FAIL rc=$rc ${seconds}s"
+    failed=$((failed + 1))
+  fi
+done
+exit $((failed > 100 ? 100 : failed))

@@ -1,0 +1,254 @@
+#include "selfsense/runtime/loop.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace selfsense::runtime {
+namespace {
+
+constexpr std::size_t kRetiredCapacity = 64;
+constexpr int kCommandsPerCycle = 8;  // bounds the cycle's work; the rest waits a cycle
+
+Fault fault_of(DriverStatus s) noexcept {
+  switch (s) {
+    case DriverStatus::kTimeout:
+    case DriverStatus::kDisconnected:
+      return Fault::kDriverTimeout;
+    case DriverStatus::kStale:
+      return Fault::kStaleSample;
+    case DriverStatus::kDeviceFault:
+      return Fault::kAmplifierFault;
+    case DriverStatus::kBadData:
+    case DriverStatus::kNotActive:
+    case DriverStatus::kOk:
+      break;
+  }
+  return Fault::kDriverError;
+}
+
+Fault fault_of(models::SampleStatus s) noexcept {
+  switch (s) {
+    case models::SampleStatus::kInputNotFinite:
+      return Fault::kInputNotFinite;
+    case models::SampleStatus::kInputOutOfRange:
+      return Fault::kInputOutOfRange;
+    default:
+      return Fault::kReconstruction;
+  }
+}
+
+}  // namespace
+
+bool LoopConfig::is_valid(std::string* why) const {
+  const auto fail = [why](const char* message) {
+    if (why != nullptr) *why = message;
+    return false;
+  };
+  if (!(sample_time >= 1.0 / 100000.0 && sample_time <= 1.0 / 100.0)) {
+    return fail("loop.rate_hz: must be within [100, 100000]");
+  }
+  if (!std::isfinite(safe_value)) return fail("safety.safe_value: must be finite");
+  if (!(strain_min < strain_max)) return fail("safety.strain_range: min must be < max");
+  if (!(stress_min < stress_max)) return fail("safety.stress_range: min must be < max");
+  if (!(watchdog_s >= 0.0 && std::isfinite(watchdog_s))) {
+    return fail("safety.watchdog_s: must be finite and >= 0");
+  }
+  if (status_period < 1) return fail("loop.status_period: must be >= 1");
+  if (command_capacity < 2) return fail("loop.command_capacity: must be >= 2");
+  return overrun.is_valid(why);
+}
+
+Loop::Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Reconstruction> model,
+           const Controller& controller, SampleSink* sink)
+    : config_(config),
+      driver_(&driver),
+      model_(std::move(model)),
+      controller_(controller),
+      sink_(sink),
+      supervisor_(config.overrun),
+      commands_(config.command_capacity),
+      answers_(config.command_capacity),
+      retired_(kRetiredCapacity) {
+  std::string why;
+  if (!config.is_valid(&why)) throw std::invalid_argument(why);
+  if (!model_) throw std::invalid_argument("loop: needs a model");
+  command_ = safe_command();
+  status_.mode = controller_.mode();
+}
+
+Loop::~Loop() = default;
+
+double Loop::safe_command() const noexcept {
+  return config_.safe_output == SafeOutput::kHold ? command_ : config_.safe_value;
+}
+
+void Loop::answer(const LoopCommand& c, CommandResult r) noexcept {
+  static_cast<void>(answers_.try_push({c.id, r, supervisor_.state()}));
+}
+
+void Loop::handle(const LoopCommand& c) noexcept {
+  ++status_.commands;
+  switch (c.kind) {
+    case CommandKind::kArm:
+      if (!estimate_valid_ || !supervisor_.arm()) return answer(c, CommandResult::kRefusedState);
+      controller_.arm(s_hat_, t_hat_, command_);
+      hold_setpoint_ = controller_.mode() == ControlMode::kForce ? t_hat_ : s_hat_;
+      last_feed_ = cycle_;
+      return answer(c, CommandResult::kDone);
+    case CommandKind::kDisarm:
+      return answer(c, supervisor_.disarm() ? CommandResult::kDone : CommandResult::kRefusedState);
+    case CommandKind::kReset:
+      if (supervisor_.state() != LoopState::kFaulted) {
+        return answer(c, CommandResult::kRefusedState);
+      }
+      if (active_causes_ != 0) return answer(c, CommandResult::kRefusedCause);
+      supervisor_.reset();
+      return answer(c, CommandResult::kDone);
+    case CommandKind::kSetpoint:
+      hold_setpoint_ = c.value;
+      wave_running_ = false;
+      last_feed_ = cycle_;
+      return answer(c, CommandResult::kDone);
+    case CommandKind::kHeartbeat:
+      last_feed_ = cycle_;
+      return answer(c, CommandResult::kDone);
+    case CommandKind::kMode:
+      // Bumpless while armed too: the new mode starts at the measured state.
+      controller_.set_mode(c.mode, s_hat_, t_hat_, command_);
+      hold_setpoint_ = c.mode == ControlMode::kForce ? t_hat_ : s_hat_;
+      wave_running_ = false;
+      return answer(c, CommandResult::kDone);
+    case CommandKind::kWave:
+      if (wave_) static_cast<void>(retired_.try_push({wave_.release(), nullptr}));
+      wave_.reset(c.wave);
+      wave_running_ = wave_ != nullptr;
+      last_feed_ = cycle_;
+      return answer(c, CommandResult::kDone);
+    case CommandKind::kStopWave:
+      if (wave_running_) hold_setpoint_ = last_wave_value_;
+      wave_running_ = false;
+      return answer(c, CommandResult::kDone);
+    case CommandKind::kGains:
+      return answer(c, controller_.set_gains(c.position, c.force) ? CommandResult::kDone
+                                                                  : CommandResult::kInvalid);
+    case CommandKind::kSwapModel:
+      if (c.model == nullptr) return answer(c, CommandResult::kInvalid);
+      c.model->adopt_state(*model_);
+      static_cast<void>(retired_.try_push({nullptr, model_.release()}));
+      model_.reset(c.model);
+      ++status_.model_swaps;
+      return answer(c, CommandResult::kDone);
+  }
+}
+
+double Loop::setpoint() noexcept {
+  if (wave_running_ && wave_) {
+    const double v = wave_->step();
+    last_wave_value_ = v;
+    if (wave_->done()) {
+      hold_setpoint_ = v;
+      wave_running_ = false;
+    }
+    return v;
+  }
+  return hold_setpoint_;
+}
+
+void Loop::cycle(bool overrun) noexcept {
+  ++cycle_;
+  for (int i = 0; i < kCommandsPerCycle; ++i) {
+    LoopCommand c;
+    if (!commands_.try_pop(c)) break;
+    handle(c);
+  }
+  active_causes_ = 0;
+  const auto cause = [this](Fault f) {
+    active_causes_ |= bit(f);
+    supervisor_.report(f, cycle_);
+  };
+
+  // read
+  InputSample in;
+  const DriverStatus read = driver_->read(in);
+  if (read != DriverStatus::kOk) cause(fault_of(read));
+
+  // estimate
+  LoopSample sample;
+  sample.cycle = cycle_;
+  sample.t = static_cast<double>(cycle_) * config_.sample_time;
+  sample.e = in.e;
+  sample.d = in.d;
+  sample.s_ref = in.s_ref;
+  sample.t_ref = in.t_ref;
+  sample.driver_status = in.device_status;
+  if (read == DriverStatus::kOk) {
+    const models::Reconstruction::Estimate est = model_->step(in.e, in.d);
+    sample.estimate_status = static_cast<std::uint8_t>(est.status);
+    ++status_.estimate_status[static_cast<std::size_t>(est.status)];
+    if (est.status != models::SampleStatus::kOk) {
+      cause(fault_of(est.status));
+    } else {
+      const bool strain_ok = !std::isfinite(est.strain) ||
+                             (est.strain >= config_.strain_min && est.strain <= config_.strain_max);
+      const bool stress_ok = est.stress >= config_.stress_min && est.stress <= config_.stress_max;
+      if (!strain_ok || !stress_ok) cause(Fault::kEstimateOutOfRange);
+      s_hat_ = std::isfinite(est.strain) ? est.strain : 0.0;
+      t_hat_ = est.stress;
+      estimate_valid_ = true;
+    }
+    sample.t_hat = est.stress;
+    sample.s_hat = est.strain;
+  }
+  supervisor_.note_cycle(overrun, cycle_);
+  if (config_.watchdog_s > 0.0 && supervisor_.armed() && !wave_running_ &&
+      static_cast<double>(cycle_ - last_feed_) * config_.sample_time > config_.watchdog_s) {
+    cause(Fault::kWatchdog);
+  }
+
+  // control: the safe output unless armed and nothing went wrong in this cycle
+  const double r = setpoint();
+  if (supervisor_.armed()) {
+    command_ = controller_.step(r, s_hat_, t_hat_);
+  } else {
+    command_ = safe_command();
+  }
+  const DriverStatus wrote = driver_->write(OutputCommand{command_});
+  if (wrote != DriverStatus::kOk) supervisor_.report(fault_of(wrote), cycle_);
+
+  // record
+  sample.setpoint = r;
+  sample.command = command_;
+  sample.state = supervisor_.state();
+  sample.mode = controller_.mode();
+  sample.faults = supervisor_.latched();
+  if (sink_ != nullptr && !sink_->push(sample)) ++status_.samples_dropped;
+
+  status_.cycle = cycle_;
+  status_.last = sample;
+  status_.state = supervisor_.state();
+  status_.mode = controller_.mode();
+  status_.faults = supervisor_.latched();
+  status_.saturations = controller_.saturations();
+  status_.wave_running = wave_running_;
+  if (cycle_ % config_.status_period == 0) {
+    for (std::size_t i = 0; i < kFaultCount; ++i)
+      status_.fault_records[i] = supervisor_.record(static_cast<Fault>(i));
+    status_.driver = driver_->counters();
+    published_.publish(status_);
+  }
+}
+
+void Loop::set_timing(const StatusSnapshot& timing) noexcept {
+  status_.overruns = timing.overruns;
+  status_.missed_periods = timing.missed_periods;
+  status_.wake_latency_p50_ns = timing.wake_latency_p50_ns;
+  status_.wake_latency_p99_ns = timing.wake_latency_p99_ns;
+  status_.wake_latency_max_ns = timing.wake_latency_max_ns;
+  status_.cycle_time_p50_ns = timing.cycle_time_p50_ns;
+  status_.cycle_time_p99_ns = timing.cycle_time_p99_ns;
+  status_.cycle_time_max_ns = timing.cycle_time_max_ns;
+  status_.last_overrun_cycle = timing.last_overrun_cycle;
+}
+
+}  // namespace selfsense::runtime

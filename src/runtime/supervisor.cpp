@@ -1,0 +1,79 @@
+#include "selfsense/runtime/supervisor.hpp"
+
+#include <array>
+
+namespace selfsense::runtime {
+
+std::string_view to_string(Fault f) noexcept {
+  constexpr std::array<std::string_view, kFaultCount> kNames{
+      "power_up",         "driver_error",       "driver_timeout",        "stale_sample",
+      "input_not_finite", "input_out_of_range", "estimate_out_of_range", "reconstruction",
+      "overrun",          "watchdog",           "amplifier_fault"};
+  const auto i = static_cast<std::size_t>(f);
+  return i < kNames.size() ? kNames[i] : std::string_view("unknown");
+}
+
+bool OverrunPolicy::is_valid(std::string* why) const {
+  const auto fail = [why](const char* message) {
+    if (why != nullptr) *why = message;
+    return false;
+  };
+  if (consecutive < 1) return fail("safety.overrun.consecutive: must be >= 1");
+  if (within_count < 1 || within_count > 64) {
+    return fail("safety.overrun.within_count: must be in [1, 64]");
+  }
+  if (window < within_count) return fail("safety.overrun.window: must be >= within_count");
+  return true;
+}
+
+Supervisor::Supervisor(const OverrunPolicy& policy) noexcept : policy_(policy) {
+  recent_.fill(-1);
+  report(Fault::kPowerUp, 0);
+}
+
+void Supervisor::report(Fault f, std::int64_t cycle) noexcept {
+  FaultRecord& r = records_[static_cast<std::size_t>(f)];
+  ++r.count;
+  if (r.first_cycle < 0 || (latched_ & bit(f)) == 0) r.first_cycle = cycle;
+  r.last_cycle = cycle;
+  latched_ |= bit(f);
+  state_ = LoopState::kFaulted;
+}
+
+void Supervisor::note_cycle(bool overrun, std::int64_t cycle) noexcept {
+  if (!overrun) {
+    consecutive_ = 0;
+    return;
+  }
+  ++consecutive_;
+  recent_[recent_next_] = cycle;
+  recent_next_ = (recent_next_ + 1) % recent_.size();
+  // The within_count-th most recent overrun, still inside the window?
+  const std::size_t back = (recent_next_ + recent_.size() - policy_.within_count) % recent_.size();
+  const std::int64_t oldest = recent_[back];
+  const bool dense = oldest >= 0 && cycle - oldest < static_cast<std::int64_t>(policy_.window);
+  if (consecutive_ >= policy_.consecutive || dense) report(Fault::kOverrun, cycle);
+}
+
+bool Supervisor::reset() noexcept {
+  if (state_ != LoopState::kFaulted) return false;
+  latched_ = 0;
+  consecutive_ = 0;
+  recent_.fill(-1);
+  state_ = LoopState::kReady;
+  return true;
+}
+
+bool Supervisor::arm() noexcept {
+  if (state_ != LoopState::kReady) return false;
+  state_ = LoopState::kArmed;
+  return true;
+}
+
+bool Supervisor::disarm() noexcept {
+  if (state_ != LoopState::kArmed) return false;
+  state_ = LoopState::kReady;
+  return true;
+}
+
+}  // namespace selfsense::runtime

@@ -1,0 +1,255 @@
+// The loop against the simulated transducer in simulated time: tracking on the self-sensed
+// signals only (the plant's true S and T are read for the figures, never by the loop), damping,
+// and every fault reaching the safe output in the cycle it occurs.
+#include "selfsense/runtime/loop.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+#include "selfsense/identification/fit_quality.hpp"
+#include "sim/simulated_transducer.hpp"
+#include "support/daemon_plant.hpp"
+
+namespace selfsense::runtime {
+namespace {
+
+constexpr double kRate = 10000.0;
+constexpr double kTs = 1.0 / kRate;
+
+const models::TransducerModel& bench_model() {
+  static const models::TransducerModel m =
+      test::identify_daemon_plant(test::daemon_plant(kRate), 40.0);
+  return m;
+}
+
+ControllerConfig bench_control() {
+  ControllerConfig c;
+  c.position.gains = {2e8, 2.5e11, 0.0};  // E per strain: plant gain about 6e-10 strain per V/m
+  c.position.tracking_time = 1e-3;
+  c.force.gains = {0.005, 10.0, 0.0};  // E per Pa: about 3 Pa per V/m against the load spring
+  c.force.tracking_time = 1e-3;
+  c.position_shaper.slew_rate = 0.05;  // strain per s: full stroke in 30 ms
+  c.force_shaper.slew_rate = 5e8;      // Pa/s
+  c.command_min = 0.0;
+  c.command_max = 2e6;
+  return c;
+}
+
+struct Bench {
+  explicit Bench(const plant::PlantConfig& plant_config, const ControllerConfig& control,
+                 LoopConfig loop_config = {})
+      : driver(plant_config) {
+    loop_config.sample_time = kTs;
+    std::string why;
+    EXPECT_TRUE(driver.configure({kTs}, &why)) << why;
+    EXPECT_TRUE(driver.activate(&why)) << why;
+    loop = std::make_unique<Loop>(
+        loop_config, driver,
+        std::make_unique<models::Reconstruction>(bench_model(), models::RuntimeOptions{kTs}),
+        Controller(control, bench_model().actuator, kTs), nullptr);
+  }
+  // Submits and runs cycles until the loop answered.
+  CommandResult send(LoopCommand c) {
+    c.id = ++next_id;
+    EXPECT_TRUE(loop->submit(c));
+    for (int i = 0; i < 10; ++i) {
+      loop->cycle(false);
+      LoopAnswer a;
+      if (loop->take_answer(a)) {
+        EXPECT_EQ(a.id, c.id);
+        return a.result;
+      }
+    }
+    ADD_FAILURE() << "no answer";
+    return CommandResult::kInvalid;
+  }
+  void run(double seconds) const {
+    const auto n = static_cast<std::int64_t>(seconds * kRate);
+    for (std::int64_t i = 0; i < n; ++i)
+      loop->cycle(false);
+  }
+  drivers::SimulatedTransducer driver;
+  std::unique_ptr<Loop> loop;
+  std::uint64_t next_id{0};
+};
+
+void start(Bench& b, ControlMode mode) {
+  b.run(0.2);
+  ASSERT_EQ(b.send({0, CommandKind::kReset}), CommandResult::kDone);
+  ASSERT_EQ(b.send({0, CommandKind::kMode, 0.0, mode}), CommandResult::kDone);
+  ASSERT_EQ(b.send({0, CommandKind::kArm}), CommandResult::kDone);
+  ASSERT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+}
+
+struct Tracking {
+  double truth_nrmse{0.0};  // true S (or T) against the setpoint, share of the setpoint range
+  double hat_nrmse{0.0};    // S_hat (or T_hat) against the setpoint
+};
+
+// Runs a setpoint trajectory; errors over the samples where `scored` is true.
+Tracking track(Bench& b, const std::vector<double>& setpoints, const std::vector<bool>& scored,
+               bool force) {
+  double sum_truth = 0.0;
+  double sum_hat = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < setpoints.size(); ++k) {
+    b.send({0, CommandKind::kSetpoint, setpoints[k]});
+    const LoopSample& s = b.loop->local_status().last;
+    if (!scored[k]) continue;
+    const double truth = force ? s.t_ref : s.s_ref;
+    const double hat = force ? s.t_hat : s.s_hat;
+    sum_truth += (truth - s.setpoint) * (truth - s.setpoint);
+    sum_hat += (hat - s.setpoint) * (hat - s.setpoint);
+    ++n;
+  }
+  for (std::size_t i = 0; i < kFaultCount; ++i) {
+    const FaultRecord& r = b.loop->supervisor().record(static_cast<Fault>(i));
+    if (r.count > 0 && i > 0) {
+      std::printf("fault %s x%llu first at cycle %lld\n",
+                  std::string(to_string(static_cast<Fault>(i))).c_str(),
+                  static_cast<unsigned long long>(r.count), static_cast<long long>(r.first_cycle));
+    }
+  }
+  const auto [lo, hi] = std::minmax_element(setpoints.begin(), setpoints.end());
+  const double range = *hi - *lo;
+  return {std::sqrt(sum_truth / static_cast<double>(n)) / range,
+          std::sqrt(sum_hat / static_cast<double>(n)) / range};
+}
+
+TEST(Loop, PositionTracksAStaircaseAndASineOnTheSelfSensedStrain) {
+  Bench b(test::daemon_plant(kRate), bench_control());
+  start(b, ControlMode::kPosition);
+  // 80 % of the stroke under the load: strain 0.1 .. 0.9 of about 1.25e-3.
+  const double lo = 0.15e-3;
+  const double hi = 1.1e-3;
+  std::vector<double> sp;
+  std::vector<bool> scored;
+  constexpr double kStep = 0.5;  // s per stair
+  constexpr double kSettle = 0.1;
+  for (const double share : {0.0, 0.5, 1.0, 0.25, 0.75, 0.1}) {
+    const double level = lo + (hi - lo) * share;
+    for (int k = 0; k < static_cast<int>(kStep * kRate); ++k) {
+      sp.push_back(level);
+      scored.push_back(k >= static_cast<int>(kSettle * kRate));
+    }
+  }
+  for (int k = 0; k < static_cast<int>(3.0 * kRate); ++k) {  // 1 Hz sine, 3 periods
+    const double phase = 2.0 * std::numbers::pi * static_cast<double>(k) * kTs;
+    sp.push_back(0.5 * (lo + hi) - 0.5 * (hi - lo) * std::cos(phase));
+    scored.push_back(k >= static_cast<int>(0.5 * kRate));
+  }
+  const Tracking t = track(b, sp, scored, false);
+  std::printf("position: true S %.3f %% of range RMS, S_hat %.3f %%\n", 100 * t.truth_nrmse,
+              100 * t.hat_nrmse);
+  // The loop holds S_hat on the setpoint (measured 0.28 %); the true S is off by the model's
+  // error under the load spring (measured 3.4 %; the goal of 0.5 % is open, see the issue).
+  EXPECT_LT(t.hat_nrmse, 0.004);
+  EXPECT_LT(t.truth_nrmse, 0.045);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+}
+
+TEST(Loop, ForceTracksStepsOnTheSelfSensedStress) {
+  Bench b(test::daemon_plant(kRate), bench_control());
+  start(b, ControlMode::kForce);
+  std::vector<double> sp;
+  std::vector<bool> scored;
+  // Within reach of 0 .. 2 MV/m against the preload (-3.3 MPa at 0 V/m).
+  for (const double level : {-5.0e6, -8.0e6, -6.0e6, -9.0e6, -4.5e6}) {
+    for (int k = 0; k < static_cast<int>(0.6 * kRate); ++k) {
+      sp.push_back(level);
+      scored.push_back(k >= static_cast<int>(0.15 * kRate));
+    }
+  }
+  const Tracking t = track(b, sp, scored, true);
+  std::printf("force: true T %.3f %% of range RMS, T_hat %.3f %%\n", 100 * t.truth_nrmse,
+              100 * t.hat_nrmse);
+  // T_hat on the setpoint (measured 0.39 %); the true T off by the model's stress error under
+  // the load spring (measured 17 %; the goal of 2 % is open, see the issue).
+  EXPECT_LT(t.hat_nrmse, 0.008);
+  EXPECT_LT(t.truth_nrmse, 0.22);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+}
+
+// Every fault kind of the simulated transducer reaches the safe output in the cycle it shows
+// up in, latches, and a reset afterwards re-arms.
+TEST(Loop, EveryFaultReachesTheSafeOutputInItsCycle) {
+  struct Case {
+    plant::FaultKind kind;
+    plant::Channel channel;
+    Fault expected;
+  };
+  const Case cases[] = {
+      {plant::FaultKind::nan_sample, plant::Channel::d, Fault::kDriverError},
+      {plant::FaultKind::out_of_range, plant::Channel::e, Fault::kDriverError},
+      {plant::FaultKind::stuck_adc, plant::Channel::d, Fault::kStaleSample},
+      {plant::FaultKind::missed_data_ready, plant::Channel::both, Fault::kStaleSample},
+      {plant::FaultKind::amplifier_fault, plant::Channel::both, Fault::kAmplifierFault},
+      {plant::FaultKind::sensor_disconnect, plant::Channel::d, Fault::kDriverError},
+  };
+  LoopConfig lc;
+  lc.safe_value = 0.0;
+  Bench b(test::daemon_plant(kRate), bench_control(), lc);
+  for (const Case& c : cases) {
+    start(b, ControlMode::kPosition);
+    b.send({0, CommandKind::kSetpoint, 0.6e-3});
+    b.run(0.3);
+    ASSERT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+    ASSERT_GT(b.loop->local_status().last.command, 1e5);
+    ASSERT_TRUE(b.driver.inject(c.kind, c.channel, 1, 5));
+    b.loop->cycle(false);
+    EXPECT_EQ(b.loop->local_status().last.state, LoopState::kArmed) << plant::to_string(c.kind);
+    b.loop->cycle(false);  // the faulty sample arrives in this cycle
+    const LoopSample& s = b.loop->local_status().last;
+    EXPECT_EQ(s.state, LoopState::kFaulted) << plant::to_string(c.kind);
+    EXPECT_EQ(s.command, 0.0) << plant::to_string(c.kind);
+    EXPECT_EQ(b.driver.command(), 0.0) << plant::to_string(c.kind);
+    EXPECT_NE(s.faults & bit(c.expected), 0U) << plant::to_string(c.kind);
+    b.run(0.01);  // the fault is over; the state stays latched
+    EXPECT_EQ(b.loop->supervisor().state(), LoopState::kFaulted);
+    EXPECT_EQ(b.loop->local_status().last.command, 0.0);
+  }
+}
+
+TEST(Loop, ArmingIsRefusedWhileFaultedAndResetIsRefusedWhileTheCauseLasts) {
+  Bench b(test::daemon_plant(kRate), bench_control());
+  b.run(0.05);
+  EXPECT_EQ(b.send({0, CommandKind::kArm}), CommandResult::kRefusedState);
+  ASSERT_TRUE(b.driver.inject(plant::FaultKind::nan_sample, plant::Channel::d, 0, 100000));
+  b.run(0.01);
+  EXPECT_EQ(b.send({0, CommandKind::kReset}), CommandResult::kRefusedCause);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kFaulted);
+}
+
+TEST(Loop, OverrunPolicyAndWatchdogFault) {
+  LoopConfig lc;
+  lc.overrun = {3, 5, 100};
+  lc.watchdog_s = 0.05;
+  Bench b(test::daemon_plant(kRate), bench_control(), lc);
+  start(b, ControlMode::kPosition);
+  b.loop->cycle(true);
+  b.loop->cycle(true);
+  b.loop->cycle(false);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+  b.loop->cycle(true);
+  b.loop->cycle(true);
+  b.loop->cycle(true);  // three in a row
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kFaulted);
+  EXPECT_NE(b.loop->supervisor().latched() & bit(Fault::kOverrun), 0U);
+
+  ASSERT_EQ(b.send({0, CommandKind::kReset}), CommandResult::kDone);
+  ASSERT_EQ(b.send({0, CommandKind::kArm}), CommandResult::kDone);
+  b.run(0.04);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+  b.run(0.02);  // no setpoint for longer than the watchdog
+  EXPECT_NE(b.loop->supervisor().latched() & bit(Fault::kWatchdog), 0U);
+  EXPECT_EQ(b.loop->local_status().last.command, 0.0);
+}
+
+}  // namespace
+}  // namespace selfsense::runtime
