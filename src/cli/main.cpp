@@ -16,10 +16,13 @@ int main(int argc, char** argv) {
   selfsense::cli::add_feedforward_command(app);
   selfsense::cli::add_import_command(app);
   selfsense::cli::add_check_config_command(app);
+  selfsense::cli::add_ctl_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const selfsense::cli::CommandExit& e) {
+    return e.status;
   } catch (const std::exception& e) {
     std::cerr << "selfsense: " << e.what() << '\n';
     return 1;
