@@ -3,7 +3,8 @@
 # job on the simulated transducer (`demo`) or every check (`test`). Idempotent and
 # non-interactive; run as root on a fresh machine (apt-get), as any user once installed.
 #
-#   scripts/setup.sh demo   install, build (Release), run the main job
+#   scripts/setup.sh demo   install, build (Release), run the main job (the daemon on the
+#                           simulated transducer; before it the operator demo and self-sensing)
 #   scripts/setup.sh test   install, format check, build (Release, -Werror), unit tests,
 #                           clang-tidy, then build and test again under ASan + UBSan
 set -euo pipefail
@@ -106,6 +107,8 @@ case "$mode" in
     say "main job: selfsense demo"
     build/src/cli/selfsense demo
     run_self_sensing
+    say "main job: selfsensed on config/sim.yaml, driven through selfsense ctl"
+    bash scripts/main_job.sh build build/main-job
     ;;
   test)
     check_format

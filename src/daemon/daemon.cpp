@@ -87,6 +87,7 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver)
 }
 
 Daemon::~Daemon() {
+  if (server_) server_->stop();
   if (runner_) runner_->stop();
   if (driver_) driver_->deactivate();
   if (recorder_) recorder_->stop();
@@ -103,14 +104,17 @@ void Daemon::block_signals() {
 }
 
 std::optional<runtime::LoopAnswer> Daemon::command(runtime::LoopCommand c,
-                                                   std::chrono::milliseconds timeout) {
+                                                   std::chrono::milliseconds timeout,
+                                                   bool* submitted) {
   const std::lock_guard lock(command_mutex_);
+  if (submitted != nullptr) *submitted = false;
   c.id = ++next_id_;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (!loop_->submit(c)) {
     if (std::chrono::steady_clock::now() > deadline) return std::nullopt;
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
+  if (submitted != nullptr) *submitted = true;
   runtime::LoopAnswer a;
   while (std::chrono::steady_clock::now() <= deadline) {
     while (loop_->take_answer(a)) {
@@ -219,6 +223,16 @@ int Daemon::run() {
         stderr, "selfsensed: real-time set-up: %s%s\n", p.c_str(),
         config_.loop.allow_degraded_timing ? " (degraded timing allowed)" : " (arming refused)");
   }
+  ControlServerConfig server_config;
+  server_config.path = config_.socket.path;
+  server_config.group = config_.socket.group;
+  server_config.max_clients = static_cast<std::size_t>(config_.socket.max_clients);
+  std::filesystem::create_directories(server_config.path.parent_path());
+  handler_ = std::make_unique<ControlHandler>(*this);
+  server_ = std::make_unique<ControlServer>(server_config, *handler_, [](std::string_view line) {
+    std::fprintf(stderr, "selfsensed: socket: %.*s\n", static_cast<int>(line.size()), line.data());
+  });
+  server_->start();
   static_cast<void>(sd_notify(0, "READY=1"));
   std::printf("selfsensed: running at %g Hz, driver %s, model %s\n", config_.loop.rate_hz,
               std::string(driver_->name()).c_str(), config_.model.string().c_str());
@@ -259,6 +273,7 @@ int Daemon::run() {
     }
   }
   static_cast<void>(sd_notify(0, "STOPPING=1"));
+  server_->stop();
   // Safe output first: disarm (the loop writes the safe output from its next cycle), then stop.
   static_cast<void>(command({0, runtime::CommandKind::kDisarm}, std::chrono::milliseconds(100)));
   runner_->stop();

@@ -60,7 +60,8 @@ TEST(DaemonConfig, ShippedConfigurationsLoad) {
 }
 
 TEST(DaemonConfig, UnknownKeysAreNamedWithTheirLine) {
-  const ConfigResult r = load(write("unknown", sim_with("  priority: 80", "  priority: 80\n  prio: 3")));
+  const ConfigResult r =
+      load(write("unknown", sim_with("  priority: 80", "  priority: 80\n  prio: 3")));
   ASSERT_FALSE(r.ok());
   EXPECT_TRUE(has(r, ".test-unknown.yaml:")) << r.problems.front();
   EXPECT_TRUE(has(r, "loop.prio")) << r.problems.front();
@@ -72,7 +73,8 @@ TEST(DaemonConfig, EveryValueProblemIsReportedAtOnce) {
   text.replace(at, 12, "priority: 120");
   const ConfigResult r = load(write("values", text));
   EXPECT_TRUE(has(r, "loop.priority: 120 must be within [1, 99]"));
-  EXPECT_TRUE(has(r, "control.filters[0].frequency_hz: 2000 Hz must be below 0.45 of the loop rate"));
+  EXPECT_TRUE(
+      has(r, "control.filters[0].frequency_hz: 2000 Hz must be below 0.45 of the loop rate"));
   EXPECT_TRUE(has(r, "control.filters[1].frequency_hz"));
   EXPECT_TRUE(has(r, "control.damping: DampingController.frequency"));
   EXPECT_TRUE(has(r, "driver.plant: the plant's sample_rate_hz 20000"));  // 4 kHz does not divide
@@ -82,8 +84,8 @@ TEST(DaemonConfig, EveryValueProblemIsReportedAtOnce) {
 }
 
 TEST(DaemonConfig, CrossFieldRules) {
-  const ConfigResult r = load(write(
-      "cross", sim_with("  setpoint_strain: [-5.0e-4, 1.5e-3]", "  setpoint_strain: [-5.0e-4, 3.0e-3]")));
+  const ConfigResult r = load(write("cross", sim_with("  setpoint_strain: [-5.0e-4, 1.5e-3]",
+                                                      "  setpoint_strain: [-5.0e-4, 3.0e-3]")));
   EXPECT_TRUE(has(r, "safety.setpoint_strain: must be an interval inside safety.strain_range"));
   const ConfigResult safe =
       load(write("safe", sim_with("safe_value_v_per_m: 0.0", "safe_value_v_per_m: 3.0e6")));
@@ -91,7 +93,8 @@ TEST(DaemonConfig, CrossFieldRules) {
 }
 
 TEST(DaemonConfig, ModelAndDriverProblemsAreNamed) {
-  const ConfigResult missing = load(write("model", sim_with("model: models/sim.yaml", "model: models/none.yaml")));
+  const ConfigResult missing =
+      load(write("model", sim_with("model: models/sim.yaml", "model: models/none.yaml")));
   EXPECT_TRUE(has(missing, "model: ")) << missing.problems.front();
   const ConfigResult driver = load(write("driver", sim_with("type: simulated", "type: ethercat")));
   EXPECT_TRUE(has(driver, "driver.type: 'ethercat' is not one of simulated"));

@@ -23,6 +23,8 @@
 #include <vector>
 
 #include "selfsense/daemon/config.hpp"
+#include "selfsense/daemon/control_handler.hpp"
+#include "selfsense/daemon/control_server.hpp"
 #include "selfsense/daemon/recorder.hpp"
 #include "selfsense/runtime/driver.hpp"
 #include "selfsense/runtime/loop.hpp"
@@ -48,9 +50,11 @@ class Daemon final {
   static void block_signals();
 
   // For the control handler (any non-real-time thread).
-  // Sends a command and waits for the loop's answer (nullopt on timeout).
+  // Sends a command and waits for the loop's answer (nullopt on timeout). *submitted says
+  // whether it reached the loop's ring (then objects it points to belong to the loop).
   std::optional<runtime::LoopAnswer> command(runtime::LoopCommand c,
-                                             std::chrono::milliseconds timeout);
+                                             std::chrono::milliseconds timeout,
+                                             bool* submitted = nullptr);
   [[nodiscard]] runtime::StatusSnapshot status() const noexcept { return loop_->status(); }
   [[nodiscard]] const DaemonConfig& config() const noexcept { return config_; }
   [[nodiscard]] Recorder& recorder() noexcept { return *recorder_; }
@@ -81,6 +85,8 @@ class Daemon final {
   runtime::SteadyClock clock_{};
   std::unique_ptr<runtime::Loop> loop_;
   std::unique_ptr<runtime::LoopRunner> runner_;
+  std::unique_ptr<ControlHandler> handler_;
+  std::unique_ptr<ControlServer> server_;
   runtime::RtSetupResult rt_setup_{};
   std::mutex command_mutex_{};  // one producer and one answer reader at a time
   std::uint64_t next_id_{0};

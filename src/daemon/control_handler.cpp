@@ -1,0 +1,192 @@
+#include "selfsense/daemon/control_handler.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <variant>
+
+#include "selfsense/control/wave_generator.hpp"
+#include "selfsense/daemon/daemon.hpp"
+#include "selfsense/runtime/supervisor.hpp"
+
+namespace selfsense::daemon {
+namespace {
+
+constexpr std::chrono::milliseconds kAnswerTimeout{500};
+
+const char* state_name(runtime::LoopState s) {
+  switch (s) {
+    case runtime::LoopState::kArmed:
+      return "armed";
+    case runtime::LoopState::kReady:
+      return "ready";
+    case runtime::LoopState::kFaulted:
+      break;
+  }
+  return "faulted";
+}
+
+nlohmann::json number_or_null(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+RequestLimits ControlHandler::limits() {
+  const DaemonConfig& c = daemon_->config();
+  RequestLimits l;
+  l.mode = daemon_->status().mode;
+  const SetpointRange strain{c.safety.setpoint_strain.min, c.safety.setpoint_strain.max};
+  const SetpointRange stress{c.safety.setpoint_stress_pa.min, c.safety.setpoint_stress_pa.max};
+  l.setpoint[static_cast<std::size_t>(runtime::ControlMode::kPosition)] = strain;
+  l.setpoint[static_cast<std::size_t>(runtime::ControlMode::kOpenLoop)] = strain;
+  l.setpoint[static_cast<std::size_t>(runtime::ControlMode::kDamping)] = strain;
+  l.setpoint[static_cast<std::size_t>(runtime::ControlMode::kForce)] = stress;
+  l.sample_time = c.sample_time();
+  l.max_frequency_hz = 0.4 * c.loop.rate_hz;
+  return l;
+}
+
+nlohmann::json ControlHandler::send(runtime::LoopCommand command, const char* what,
+                                    bool* submitted) {
+  const auto answer = daemon_->command(command, kAnswerTimeout, submitted);
+  if (!answer) return error_reply(std::string(what) + ": the loop did not answer in time");
+  switch (answer->result) {
+    case runtime::CommandResult::kDone:
+      return ok_reply({{"state", state_name(answer->state)}});
+    case runtime::CommandResult::kRefusedState:
+      return error_reply(std::string(what) + ": not allowed while " + state_name(answer->state) +
+                         (answer->state == runtime::LoopState::kFaulted ? " (reset first)" : ""));
+    case runtime::CommandResult::kRefusedCause:
+      return error_reply(std::string(what) + ": a fault's cause is still present");
+    case runtime::CommandResult::kInvalid:
+      break;
+  }
+  return error_reply(std::string(what) + ": refused by the control law");
+}
+
+nlohmann::json ControlHandler::status() {
+  const runtime::StatusSnapshot s = daemon_->status();
+  nlohmann::json faults = nlohmann::json::array();
+  nlohmann::json fault_details = nlohmann::json::object();
+  for (std::size_t i = 0; i < runtime::kFaultCount; ++i) {
+    const auto f = static_cast<runtime::Fault>(i);
+    const runtime::FaultRecord& r = s.fault_records[i];
+    if ((s.faults & runtime::bit(f)) != 0U) faults.push_back(std::string(runtime::to_string(f)));
+    if (r.count > 0) {
+      fault_details[std::string(runtime::to_string(f))] = {
+          {"count", r.count}, {"first_cycle", r.first_cycle}, {"last_cycle", r.last_cycle}};
+    }
+  }
+  const RecorderCounters rec = daemon_->recorder().counters();
+  nlohmann::json counters = {
+      {"cycles", s.cycle},
+      {"commands", s.commands},
+      {"saturations", s.saturations},
+      {"samples_dropped", rec.samples_dropped},
+      {"rows_lost", rec.rows_lost},
+      {"write_errors", rec.write_errors},
+      {"flight_dumps", rec.flight_dumps},
+      {"rows_written", rec.rows_written},
+      {"files", rec.files},
+      {"model_swaps", s.model_swaps},
+      {"driver_reads", s.driver.reads},
+      {"driver_errors", s.driver.errors},
+      {"driver_timeouts", s.driver.timeouts},
+      {"driver_stale", s.driver.stale},
+      {"driver_bad_data", s.driver.bad_data},
+      {"driver_device_faults", s.driver.device_faults},
+      {"driver_retries", s.driver.retries},
+      {"driver_reconnects", s.driver.reconnects},
+  };
+  nlohmann::json estimate_status = nlohmann::json::object();
+  for (std::size_t i = 0; i < models::kSampleStatusCount; ++i) {
+    estimate_status[std::string(models::to_string(static_cast<models::SampleStatus>(i)))] =
+        s.estimate_status[i];
+  }
+  counters["estimate_status"] = estimate_status;
+  const auto path = daemon_->recorder().current_path();
+  nlohmann::json rt_problems = nlohmann::json::array();
+  for (const std::string& p : daemon_->rt_setup().problems)
+    rt_problems.push_back(p);
+  return ok_reply({
+      {"state", state_name(s.state)},
+      {"mode", std::string(mode_name(s.mode))},
+      {"faults", faults},
+      {"fault_details", fault_details},
+      {"counters", counters},
+      {"timing",
+       {{"rate_hz", daemon_->config().loop.rate_hz},
+        {"overruns", s.overruns},
+        {"missed_periods", s.missed_periods},
+        {"last_overrun_cycle", s.last_overrun_cycle},
+        {"wake_latency_ns", {{"p50", s.wake_latency_p50_ns}, {"p99", s.wake_latency_p99_ns},
+                             {"max", s.wake_latency_max_ns}}},
+        {"cycle_time_ns", {{"p50", s.cycle_time_p50_ns}, {"p99", s.cycle_time_p99_ns},
+                           {"max", s.cycle_time_max_ns}}},
+        {"degraded", daemon_->degraded_timing()},
+        {"realtime_problems", rt_problems}}},
+      {"recording", {{"path", path ? nlohmann::json(path->string()) : nlohmann::json(nullptr)}}},
+      {"estimate",
+       {{"E", number_or_null(s.last.e)}, {"D", number_or_null(s.last.d)},
+        {"T_hat", number_or_null(s.last.t_hat)}, {"S_hat", number_or_null(s.last.s_hat)},
+        {"setpoint", number_or_null(s.last.setpoint)}, {"command", number_or_null(s.last.command)},
+        {"S", number_or_null(s.last.s_ref)}, {"T", number_or_null(s.last.t_ref)}}},
+      {"wave_running", s.wave_running},
+  });
+}
+
+nlohmann::json ControlHandler::handle(const Request& request, const PeerCredentials& /*peer*/) {
+  using runtime::CommandKind;
+  if (std::holds_alternative<StatusRequest>(request)) return status();
+  if (std::holds_alternative<ArmRequest>(request)) {
+    if (!daemon_->may_arm()) {
+      return error_reply(
+          "arm: the loop has no real-time scheduling or locked memory (loop.allow_degraded_timing "
+          "is false); see status timing.realtime_problems");
+    }
+    return send({0, CommandKind::kArm}, "arm");
+  }
+  if (std::holds_alternative<DisarmRequest>(request)) return send({0, CommandKind::kDisarm}, "disarm");
+  if (std::holds_alternative<ResetRequest>(request)) return send({0, CommandKind::kReset}, "reset");
+  if (const auto* sp = std::get_if<SetpointRequest>(&request)) {
+    return send({0, CommandKind::kSetpoint, sp->value}, "setpoint");
+  }
+  if (const auto* m = std::get_if<ModeRequest>(&request)) {
+    return send({0, CommandKind::kMode, 0.0, m->mode}, "mode");
+  }
+  if (const auto* w = std::get_if<WaveRequest>(&request)) {
+    if (w->stop) return send({0, CommandKind::kStopWave}, "wave");
+    auto wave = std::make_unique<control::WaveGenerator>(w->wave, daemon_->config().sample_time());
+    runtime::LoopCommand c{0, CommandKind::kWave};
+    c.wave = wave.get();
+    bool submitted = false;
+    nlohmann::json reply = send(c, "wave", &submitted);
+    // Once in the loop's ring the loop owns it (and hands it back through `retired`).
+    if (submitted) static_cast<void>(wave.release());
+    return reply;
+  }
+  if (const auto* r = std::get_if<RecordRequest>(&request)) {
+    try {
+      if (r->action == RecordRequest::Action::kStart) {
+        return ok_reply({{"path", daemon_->recorder().start_file().string()}});
+      }
+      const auto path = daemon_->recorder().stop_file();
+      return ok_reply({{"path", path ? nlohmann::json(path->string()) : nlohmann::json(nullptr)}});
+    } catch (const std::exception& e) {
+      return error_reply(std::string("record: ") + e.what());
+    }
+  }
+  if (std::holds_alternative<ReloadRequest>(request)) {
+    const std::vector<std::string> problems = daemon_->reload();
+    if (problems.empty()) return ok_reply({{"reloaded", "gains"}});
+    std::string text;
+    for (const std::string& p : problems)
+      text += (text.empty() ? "" : "; ") + p;
+    return error_reply("reload: " + text);
+  }
+  return error_reply("unknown request");
+}
+
+}  // namespace selfsense::daemon
