@@ -121,18 +121,26 @@ nlohmann::json ControlHandler::status() {
         {"overruns", s.overruns},
         {"missed_periods", s.missed_periods},
         {"last_overrun_cycle", s.last_overrun_cycle},
-        {"wake_latency_ns", {{"p50", s.wake_latency_p50_ns}, {"p99", s.wake_latency_p99_ns},
-                             {"max", s.wake_latency_max_ns}}},
-        {"cycle_time_ns", {{"p50", s.cycle_time_p50_ns}, {"p99", s.cycle_time_p99_ns},
-                           {"max", s.cycle_time_max_ns}}},
+        {"wake_latency_ns",
+         {{"p50", s.wake_latency_p50_ns},
+          {"p99", s.wake_latency_p99_ns},
+          {"max", s.wake_latency_max_ns}}},
+        {"cycle_time_ns",
+         {{"p50", s.cycle_time_p50_ns},
+          {"p99", s.cycle_time_p99_ns},
+          {"max", s.cycle_time_max_ns}}},
         {"degraded", daemon_->degraded_timing()},
         {"realtime_problems", rt_problems}}},
       {"recording", {{"path", path ? nlohmann::json(path->string()) : nlohmann::json(nullptr)}}},
       {"estimate",
-       {{"E", number_or_null(s.last.e)}, {"D", number_or_null(s.last.d)},
-        {"T_hat", number_or_null(s.last.t_hat)}, {"S_hat", number_or_null(s.last.s_hat)},
-        {"setpoint", number_or_null(s.last.setpoint)}, {"command", number_or_null(s.last.command)},
-        {"S", number_or_null(s.last.s_ref)}, {"T", number_or_null(s.last.t_ref)}}},
+       {{"E", number_or_null(s.last.e)},
+        {"D", number_or_null(s.last.d)},
+        {"T_hat", number_or_null(s.last.t_hat)},
+        {"S_hat", number_or_null(s.last.s_hat)},
+        {"setpoint", number_or_null(s.last.setpoint)},
+        {"command", number_or_null(s.last.command)},
+        {"S", number_or_null(s.last.s_ref)},
+        {"T", number_or_null(s.last.t_ref)}}},
       {"wave_running", s.wave_running},
   });
 }
@@ -148,7 +156,8 @@ nlohmann::json ControlHandler::handle(const Request& request, const PeerCredenti
     }
     return send({0, CommandKind::kArm}, "arm");
   }
-  if (std::holds_alternative<DisarmRequest>(request)) return send({0, CommandKind::kDisarm}, "disarm");
+  if (std::holds_alternative<DisarmRequest>(request))
+    return send({0, CommandKind::kDisarm}, "disarm");
   if (std::holds_alternative<ResetRequest>(request)) return send({0, CommandKind::kReset}, "reset");
   if (const auto* sp = std::get_if<SetpointRequest>(&request)) {
     return send({0, CommandKind::kSetpoint, sp->value}, "setpoint");

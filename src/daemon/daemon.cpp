@@ -2,6 +2,7 @@
 
 #include <systemd/sd-daemon.h>
 
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
@@ -82,7 +83,7 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver)
   loop_ = std::make_unique<runtime::Loop>(config_.loop_config(), *driver_,
                                           std::move(reconstruction), controller, sink_.get());
   runner_ = std::make_unique<runtime::LoopRunner>(
-      *loop_, clock_, static_cast<std::int64_t>(ts * 1e9 + 0.5),
+      *loop_, clock_, std::llround(ts * 1e9),
       runtime::RtOptions{config_.loop.priority, config_.loop.cpu});
 }
 
@@ -210,7 +211,7 @@ void Daemon::write_telemetry() {
   try {
     write_textfile(config_.telemetry.prometheus_file, text);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "selfsensed: telemetry: %s\n", e.what());
+    static_cast<void>(std::fprintf(stderr, "selfsensed: telemetry: %s\n", e.what()));
   }
 }
 
@@ -219,9 +220,9 @@ int Daemon::run() {
   if (config_.recorder.record_at_start) static_cast<void>(recorder_->start_file());
   rt_setup_ = runner_->start();
   for (const std::string& p : rt_setup_.problems) {
-    std::fprintf(
+    static_cast<void>(std::fprintf(
         stderr, "selfsensed: real-time set-up: %s%s\n", p.c_str(),
-        config_.loop.allow_degraded_timing ? " (degraded timing allowed)" : " (arming refused)");
+        config_.loop.allow_degraded_timing ? " (degraded timing allowed)" : " (arming refused)"));
   }
   ControlServerConfig server_config;
   server_config.path = config_.socket.path;
@@ -230,13 +231,14 @@ int Daemon::run() {
   std::filesystem::create_directories(server_config.path.parent_path());
   handler_ = std::make_unique<ControlHandler>(*this);
   server_ = std::make_unique<ControlServer>(server_config, *handler_, [](std::string_view line) {
-    std::fprintf(stderr, "selfsensed: socket: %.*s\n", static_cast<int>(line.size()), line.data());
+    static_cast<void>(std::fprintf(stderr, "selfsensed: socket: %.*s\n",
+                                   static_cast<int>(line.size()), line.data()));
   });
   server_->start();
   static_cast<void>(sd_notify(0, "READY=1"));
   std::printf("selfsensed: running at %g Hz, driver %s, model %s\n", config_.loop.rate_hz,
               std::string(driver_->name()).c_str(), config_.model.string().c_str());
-  std::fflush(stdout);
+  static_cast<void>(std::fflush(stdout));
 
   sigset_t set;
   sigemptyset(&set);
@@ -254,8 +256,9 @@ int Daemon::run() {
       static_cast<void>(sd_notify(0, "RELOADING=1"));
       const std::vector<std::string> problems = reload();
       for (const std::string& p : problems)
-        std::fprintf(stderr, "selfsensed: reload refused: %s\n", p.c_str());
-      if (problems.empty()) std::fprintf(stderr, "selfsensed: reloaded the gains\n");
+        static_cast<void>(std::fprintf(stderr, "selfsensed: reload refused: %s\n", p.c_str()));
+      if (problems.empty())
+        static_cast<void>(std::fprintf(stderr, "selfsensed: reloaded the gains\n"));
       static_cast<void>(sd_notify(0, "READY=1"));
     }
     const std::uint64_t progress = runner_->progress();

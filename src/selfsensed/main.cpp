@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
       selfsense::daemon::load_config(config_path, &registry);
   if (!config.ok()) {
     for (const std::string& p : config.problems)
-      std::fprintf(stderr, "%s\n", p.c_str());
+      static_cast<void>(std::fprintf(stderr, "%s\n", p.c_str()));
     return 1;
   }
   try {
@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
     selfsense::daemon::Daemon daemon(config.config, registry.create());
     return daemon.run();
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "selfsensed: %s\n", e.what());
+    static_cast<void>(std::fprintf(stderr, "selfsensed: %s\n", e.what()));
     return 1;
   }
 }

@@ -17,7 +17,7 @@ const std::filesystem::path kConfigDir = std::filesystem::path(SELFSENSE_SOURCE_
 
 // Writes a configuration beside the shipped ones (so models/ and plant/ resolve).
 std::filesystem::path write(const std::string& name, const std::string& text) {
-  const std::filesystem::path path = kConfigDir / (".test-" + name + ".yaml");
+  std::filesystem::path path = kConfigDir / (".test-" + name + ".yaml");
   std::ofstream(path) << text;
   return path;
 }

@@ -29,8 +29,7 @@ class ControlHandler final : public RequestHandler {
 
  private:
   nlohmann::json status();
-  nlohmann::json send(runtime::LoopCommand command, const char* what,
-                      bool* submitted = nullptr);
+  nlohmann::json send(runtime::LoopCommand command, const char* what, bool* submitted = nullptr);
 
   Daemon* daemon_;
 };
