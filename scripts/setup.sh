@@ -100,6 +100,18 @@ run_vm_tests() {
   run_tests "$dir" -L vm
 }
 
+# The lock-free hand-over and the threads around the loop (rings, status seqlock, control
+# socket server and clients) under ThreadSanitizer: only those test programs are built.
+run_thread_sanitizer() {
+  local dir=build-tsan
+  say "tests: ThreadSanitizer on the rings and the control socket"
+  cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Debug -DSELFSENSE_WERROR=ON \
+    -DSELFSENSE_SANITIZE=thread -DSELFSENSE_BUILD_BENCHMARKS=OFF >/dev/null
+  cmake --build "$dir" -j "$jobs" --target runtime_tests daemon_control_tests
+  "$dir/tests/runtime/runtime_tests" --gtest_brief=1
+  "$dir/tests/daemon/daemon_control_tests" --gtest_brief=1
+}
+
 install_missing
 case "$mode" in
   demo)
@@ -120,6 +132,7 @@ case "$mode" in
       -DSELFSENSE_SANITIZE=address,undefined -DSELFSENSE_BUILD_BENCHMARKS=OFF
     # The accuracy figures are checked in the Release run; under the sanitizers they only cost time.
     run_tests build-sanitize -LE 'accuracy|vm'
+    run_thread_sanitizer
     say "all checks passed"
     ;;
   *)

@@ -10,12 +10,21 @@
 #include <ctime>
 #include <new>
 
-// ASan serves malloc itself; defining malloc here would take blocks away from it.
-#if defined(__SANITIZE_ADDRESS__)
+// ASan and TSan serve malloc themselves; defining malloc here would take blocks away from them.
+// Both count C allocations through the sanitizer's hooks instead. TSan also intercepts the
+// pthread locks it tracks, so under TSan locks are not counted (the Release and ASan runs do).
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define SELFSENSE_COUNTER_ASAN 1
 #elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
 #define SELFSENSE_COUNTER_ASAN 1
+#endif
+#endif
+#if defined(__SANITIZE_THREAD__)
+#define SELFSENSE_COUNTER_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define SELFSENSE_COUNTER_TSAN 1
 #endif
 #endif
 
@@ -314,6 +323,7 @@ void* pvalloc(std::size_t size) noexcept {
 }  // extern "C"
 #endif
 
+#ifndef SELFSENSE_COUNTER_TSAN
 // ---- locks ------------------------------------------------------------------------------------
 
 namespace {
@@ -406,3 +416,4 @@ int pthread_rwlock_clockwrlock(pthread_rwlock_t* rwlock, clockid_t clockid,
 }
 
 }  // extern "C"
+#endif  // SELFSENSE_COUNTER_TSAN
