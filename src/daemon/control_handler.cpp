@@ -15,18 +15,6 @@ namespace {
 
 constexpr std::chrono::milliseconds kAnswerTimeout{500};
 
-const char* state_name(runtime::LoopState s) {
-  switch (s) {
-    case runtime::LoopState::kArmed:
-      return "armed";
-    case runtime::LoopState::kReady:
-      return "ready";
-    case runtime::LoopState::kFaulted:
-      break;
-  }
-  return "faulted";
-}
-
 nlohmann::json number_or_null(double x) {
   return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
 }
@@ -54,9 +42,10 @@ nlohmann::json ControlHandler::send(runtime::LoopCommand command, const char* wh
   if (!answer) return error_reply(std::string(what) + ": the loop did not answer in time");
   switch (answer->result) {
     case runtime::CommandResult::kDone:
-      return ok_reply({{"state", state_name(answer->state)}});
+      return ok_reply({{"state", runtime::to_string(answer->state)}});
     case runtime::CommandResult::kRefusedState:
-      return error_reply(std::string(what) + ": not allowed while " + state_name(answer->state) +
+      return error_reply(std::string(what) + ": not allowed while " +
+                         runtime::to_string(answer->state) +
                          (answer->state == runtime::LoopState::kFaulted ? " (reset first)" : ""));
     case runtime::CommandResult::kRefusedCause:
       return error_reply(std::string(what) + ": a fault's cause is still present");
@@ -111,7 +100,7 @@ nlohmann::json ControlHandler::status() {
   for (const std::string& p : daemon_->rt_setup().problems)
     rt_problems.push_back(p);
   return ok_reply({
-      {"state", state_name(s.state)},
+      {"state", runtime::to_string(s.state)},
       {"mode", std::string(mode_name(s.mode))},
       {"faults", faults},
       {"fault_details", fault_details},

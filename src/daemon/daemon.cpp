@@ -50,18 +50,6 @@ std::string fault_name(unsigned bit) {
   return std::string(runtime::to_string(static_cast<runtime::Fault>(bit)));
 }
 
-const char* state_name(runtime::LoopState s) {
-  switch (s) {
-    case runtime::LoopState::kArmed:
-      return "armed";
-    case runtime::LoopState::kReady:
-      return "ready";
-    case runtime::LoopState::kFaulted:
-      break;
-  }
-  return "faulted";
-}
-
 }  // namespace
 
 Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver)
@@ -184,7 +172,7 @@ void Daemon::notify_status() {
     faults += faults.empty() ? "" : ",";
     faults += runtime::to_string(static_cast<runtime::Fault>(i));
   }
-  const std::string line = std::string("STATUS=") + state_name(s.state) + ", cycle " +
+  const std::string line = std::string("STATUS=") + runtime::to_string(s.state) + ", cycle " +
                            std::to_string(s.cycle) + ", faults [" + faults + "]" +
                            (degraded_timing() ? ", degraded timing" : "");
   static_cast<void>(sd_notify(0, line.c_str()));

@@ -14,6 +14,19 @@ namespace selfsense::runtime {
 
 enum class LoopState : std::uint8_t { kFaulted = 0, kReady = 1, kArmed = 2 };
 
+// "faulted", "ready", "armed": the names of the status JSON and the recordings' comments.
+[[nodiscard]] constexpr const char* to_string(LoopState s) noexcept {
+  switch (s) {
+    case LoopState::kArmed:
+      return "armed";
+    case LoopState::kReady:
+      return "ready";
+    case LoopState::kFaulted:
+      break;
+  }
+  return "faulted";
+}
+
 enum class ControlMode : std::uint8_t { kPosition = 0, kForce = 1, kOpenLoop = 2, kDamping = 3 };
 
 struct LoopSample {
