@@ -10,6 +10,8 @@ vm_check_test "${1:?usage: tests/vm/daemon_systemd.sh OUT_DIR}" daemon_systemd \
   'verify=ok' \
   'is-active=active' \
   'nrestarts_while_running=0' \
+  'socket_mode=660 selfsense' \
+  'ctl_state=(faulted|ready|armed)' \
   'telemetry=yes' \
   'nrestarts_after_freeze=[1-9][0-9]*' \
   'watchdog_timeout_logged=yes' \

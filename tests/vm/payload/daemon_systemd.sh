@@ -52,6 +52,11 @@ echo "is-active=$state"
 [ "$state" = active ] || fail "not active after READY=1"
 sleep 8  # longer than WatchdogSec: the daemon's own pings keep it alive
 echo "nrestarts_while_running=$(prop NRestarts)"
+# The control socket under the unit's RuntimeDirectory, mode 0660, group selfsense.
+sock=/run/selfsensed/control.sock
+echo "socket_mode=$(stat -c '%a %G' "$sock" 2>/dev/null || echo missing)"
+reply=$(selfsense ctl --socket "$sock" status 2>&1) || true
+echo "ctl_state=$(sed -n 's/.*"state":"\([a-z]*\)".*/\1/p' <<<"$reply")"
 echo "status_text=$(prop StatusText)"
 [ -s /var/lib/selfsensed/selfsensed.prom ] && echo "telemetry=yes" || echo "telemetry=no"
 
