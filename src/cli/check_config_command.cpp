@@ -27,7 +27,7 @@ void add_check_config_command(CLI::App& app) {
     }
     for (const std::string& p : result.problems)
       std::printf("%s\n", p.c_str());
-    throw CLI::RuntimeError(1);
+    throw CommandExit{1};
   });
 }
 

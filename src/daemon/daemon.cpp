@@ -52,8 +52,9 @@ std::string fault_name(unsigned bit) {
 
 }  // namespace
 
-Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver)
-    : config_(std::move(config)), driver_(std::move(driver)) {
+Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
+               DriverSectionReader& driver_reader)
+    : config_(std::move(config)), driver_reader_(&driver_reader), driver_(std::move(driver)) {
   const double ts = config_.sample_time();
   const models::TransducerModel model = models::load_model(config_.model);
   auto reconstruction = std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts});
@@ -124,12 +125,8 @@ void Daemon::free_retired() {
 }
 
 std::vector<std::string> Daemon::reload() {
-  DriverSectionReader* no_driver = nullptr;
-  ConfigResult next = load_config(config_.source, no_driver);
-  std::vector<std::string> problems;
-  for (const std::string& p : next.problems) {
-    if (p.find("driver.type: no driver registry") == std::string::npos) problems.push_back(p);
-  }
+  ConfigResult next = load_config(config_.source, driver_reader_);
+  std::vector<std::string> problems = next.problems;
   if (!problems.empty()) return problems;
   const DaemonConfig& n = next.config;
   const auto refuse = [&](bool changed, const char* key) {

@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
   }
   try {
     selfsense::daemon::Daemon::block_signals();  // before any thread starts
-    selfsense::daemon::Daemon daemon(config.config, registry.create());
+    selfsense::daemon::Daemon daemon(config.config, registry.create(), registry);
     return daemon.run();
   } catch (const std::exception& e) {
     static_cast<void>(std::fprintf(stderr, "selfsensed: %s\n", e.what()));

@@ -47,4 +47,30 @@ fi
 rm -f "$bad"
 grep -q '.e2e-bad.yaml:[0-9]*: loop.priority: 200 must be within' "$out/bad.err" || fail "priority not named: $(cat "$out/bad.err")"
 grep -q 'control.filters\[0\].frequency_hz' "$out/bad.err" || fail "notch not named: $(cat "$out/bad.err")"
+# Reload: the gains through `ctl reload` and SIGHUP; a key that cannot change while running is
+# refused by name and the daemon keeps running; SIGTERM still ends it with status 0.
+cfg=$root/config/.e2e-reload.yaml
+sed -e "s|path: ../build/sim/control.sock|path: $out/reload.sock|" \
+  -e "s|directory: ../build/sim/recordings|directory: $out/reload-rec|" \
+  -e "s|prometheus_file: ../build/sim/selfsensed.prom|prometheus_file: $out/reload.prom|" \
+  "$root/config/sim.yaml" >"$cfg"
+"$build/src/selfsensed/selfsensed" --config "$cfg" >"$out/reload.log" 2>&1 &
+pid=$!
+for _ in $(seq 100); do [ -S "$out/reload.sock" ] && break; sleep 0.1; done
+ctl() { "$build/src/cli/selfsense" ctl --socket "$out/reload.sock" "$@"; }
+sed -i 's/kp: 2.0e8/kp: 1.0e8/' "$cfg"
+ctl reload | grep -q '"reloaded":"gains"' || fail "a gain change was not reloaded"
+sed -i "s/rate_hz: 10000/rate_hz: 20000/" "$cfg"
+if reply=$(ctl reload); then fail "a rate change was accepted: $reply"; fi
+grep -q 'loop.rate_hz: cannot change while running' <<<"$reply" || fail "refusal does not name the key: $reply"
+kill -HUP "$pid"
+for _ in $(seq 50); do grep -q 'reload refused' "$out/reload.log" && break; sleep 0.1; done
+grep -q 'reload refused: .*loop.rate_hz' "$out/reload.log" || fail "SIGHUP refusal not logged: $(cat "$out/reload.log")"
+ctl status | grep -q '"state"' || fail "the daemon stopped answering after the refused reload"
+kill -TERM "$pid"
+rc=0
+wait "$pid" || rc=$?
+rm -f "$cfg"
+[ "$rc" -eq 0 ] || fail "selfsensed exited with $rc after SIGTERM"
+echo "ok: reload of the gains, refusal naming loop.rate_hz, SIGTERM exit 0"
 echo "daemon end to end: ok"

@@ -36,8 +36,11 @@ namespace selfsense::daemon {
 class Daemon final {
  public:
   // Builds everything (loads the model, configures and activates the driver, prepares the
-  // recorder); throws std::runtime_error naming what failed. Starts no thread.
-  Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver);
+  // recorder); throws std::runtime_error naming what failed. Starts no thread. The driver
+  // section reader (the driver registry) reads the driver's keys again on reload; it must
+  // outlive the daemon.
+  Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
+         DriverSectionReader& driver_reader);
   Daemon(const Daemon&) = delete;
   Daemon& operator=(const Daemon&) = delete;
   Daemon(Daemon&&) = delete;
@@ -79,6 +82,7 @@ class Daemon final {
   void write_telemetry();
 
   DaemonConfig config_;
+  DriverSectionReader* driver_reader_;
   std::unique_ptr<runtime::Driver> driver_;
   std::unique_ptr<Recorder> recorder_;
   std::unique_ptr<Sink> sink_;
