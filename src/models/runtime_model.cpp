@@ -107,6 +107,30 @@ RestoreResult restore_from(Impl& impl, const ModelIdentity& identity,
   return RestoreResult::kOk;
 }
 
+// One step behind the input gate (header comment): a rejected sample advances the kernel with
+// the last accepted inputs held and returns that estimate with the rejecting status.
+template <typename Out, typename Kernel>
+Out gated_step(const detail::InputGate& gate, detail::HeldInputs& held, Out& last,
+               StatusCounts& counts, double first, double second, Kernel&& kernel) noexcept {
+  const SampleStatus status = gate.check(first, second);
+  if (status != SampleStatus::kOk) {
+    counts.add(status);
+    if (held.valid) {
+      const SampleStatus previous = last.status;
+      last = kernel(held.first, held.second);
+      last.status = previous;
+    }
+    Out out = last;
+    out.status = status;
+    return out;
+  }
+  const Out out = kernel(first, second);
+  counts.add(out.status);
+  held = {first, second, true};
+  last = out;
+  return out;
+}
+
 template <typename Impl>
 std::size_t state_size_of(const Impl& impl) noexcept {
   return dispatch(impl, [](const auto& m) { return m.state_size(); });
@@ -181,7 +205,7 @@ Reconstruction::Reconstruction(const TransducerModel& model, const RuntimeOption
       last_{0.0, kNaN, SampleStatus::kOk} {
   identity_ = {model.structure, parameter_hash(model), state_size_of(impl_)};
   scratch_.resize(identity_.state_size);
-  last_drive_ = initial_input(model);
+  held_.first = initial_input(model);
 }
 
 bool Reconstruction::has_strain() const noexcept {
@@ -190,23 +214,8 @@ bool Reconstruction::has_strain() const noexcept {
 }
 
 Reconstruction::Estimate Reconstruction::step(double drive, double sensed) noexcept {
-  const SampleStatus gate = gate_.check(drive, sensed);
-  if (gate != SampleStatus::kOk) {
-    counts_.add(gate);
-    // Held input: the plays keep their memory, the creep lags keep time.
-    if (last_valid_) {
-      const Estimate held = kernel_step(last_drive_, last_sensed_);
-      last_ = {held.stress, held.strain, last_.status};
-    }
-    return {last_.stress, last_.strain, gate};
-  }
-  const Estimate out = kernel_step(drive, sensed);
-  counts_.add(out.status);
-  last_drive_ = drive;
-  last_sensed_ = sensed;
-  last_valid_ = true;
-  last_ = out;
-  return out;
+  return gated_step(gate_, held_, last_, counts_, drive, sensed,
+                    [this](double x, double y) { return kernel_step(x, y); });
 }
 
 Reconstruction::Estimate Reconstruction::kernel_step(double drive, double sensed) noexcept {
@@ -231,7 +240,7 @@ RestoreResult Reconstruction::restore_state(const SavedState& in) noexcept {
 }
 
 void Reconstruction::memory(detail::ModelMemory& out) const noexcept {
-  out.last_input = last_drive_;
+  out.last_input = held_.first;
   if (const auto* affine = std::get_if<Affine>(&impl_)) {
     if (affine->sensor()) out.add(memory_of(affine->sensor()->op()));
     if (affine->actuator()) out.add(memory_of(affine->actuator()->op()));
@@ -249,9 +258,7 @@ void Reconstruction::adopt_state(const Reconstruction& running) noexcept {
   } else {
     adopt_stream(from, std::get<Vectorial>(impl_)->stream(), scratch_);
   }
-  last_drive_ = running.last_drive_;
-  last_sensed_ = running.last_sensed_;
-  last_valid_ = running.last_valid_;
+  held_ = running.held_;
   last_ = running.last_;
 }
 
@@ -267,22 +274,8 @@ Simulation::Simulation(const TransducerModel& model, const RuntimeOptions& optio
 }
 
 Simulation::Output Simulation::step(double drive, double stress) noexcept {
-  const SampleStatus gate = gate_.check(drive, stress);
-  if (gate != SampleStatus::kOk) {
-    counts_.add(gate);
-    if (last_valid_) {
-      const Output held = kernel_step(last_drive_, last_stress_);
-      last_ = {held.sensed, held.strain, last_.status};
-    }
-    return {last_.sensed, last_.strain, gate};
-  }
-  const Output out = kernel_step(drive, stress);
-  counts_.add(out.status);
-  last_drive_ = drive;
-  last_stress_ = stress;
-  last_valid_ = true;
-  last_ = out;
-  return out;
+  return gated_step(gate_, held_, last_, counts_, drive, stress,
+                    [this](double x, double y) { return kernel_step(x, y); });
 }
 
 Simulation::Output Simulation::kernel_step(double drive, double stress) noexcept {

@@ -55,6 +55,13 @@ struct RuntimeOptions {
 namespace detail {
 struct ModelMemory;
 
+// The last accepted pair of inputs (drive and sensed, or drive and stress).
+struct HeldInputs {
+  double first{0.0};
+  double second{0.0};
+  bool valid{false};
+};
+
 // The checks every runtime model makes before a sample reaches its operators.
 class InputGate {
  public:
@@ -115,9 +122,7 @@ class Reconstruction final {
   ModelIdentity identity_{};
   double sample_time_{0.0};
   double identified_ts_{0.0};
-  double last_drive_{0.0};  // the last accepted inputs
-  double last_sensed_{0.0};
-  bool last_valid_{false};
+  detail::HeldInputs held_{};  // the last accepted inputs
   Estimate last_{};
   StatusCounts counts_{};
   std::vector<double> scratch_{};  // sized once: adopt_state() builds the new state here
@@ -162,9 +167,7 @@ class Simulation final {
   ModelIdentity identity_{};
   double sample_time_{0.0};
   double identified_ts_{0.0};
-  double last_drive_{0.0};  // the last accepted inputs
-  double last_stress_{0.0};
-  bool last_valid_{false};
+  detail::HeldInputs held_{};  // the last accepted inputs
   Output last_{};
   StatusCounts counts_{};
 };
