@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <array>
 #include <fstream>
 #include <optional>
 #include <stdexcept>
@@ -112,6 +113,39 @@ std::optional<InputRange> read_range(YamlMap& map, std::string_view key) {
   return InputRange{range[0], range[1]};
 }
 
+// The scalar keys of a correction (channel_correction.hpp), shared by reading and writing.
+template <typename C>
+auto correction_scalars(C& c) {
+  return std::array<std::pair<const char*, decltype(&c.gain)>, 14>{{
+      {"gain", &c.gain},
+      {"offset", &c.offset},
+      {"temperature_reference_degc", &c.temperature_reference_degc},
+      {"temperature_gain_per_k", &c.temperature_gain_per_k},
+      {"temperature_offset_per_k", &c.temperature_offset_per_k},
+      {"temperature_drive_per_k", &c.temperature_drive_per_k},
+      {"stress_gain_per_pa", &c.stress_gain_per_pa},
+      {"drive_quadratic", &c.drive_quadratic},
+      {"drive_cubic", &c.drive_cubic},
+      {"sensed_quadratic", &c.sensed_quadratic},
+      {"dynamics_frequency_hz", &c.dynamics_frequency_hz},
+      {"dynamics_damping", &c.dynamics_damping},
+      {"leakage_tau_s", &c.leakage_tau_s},
+      {"delay_s", &c.delay_s},
+  }};
+}
+
+std::optional<ChannelCorrection> read_correction(YamlMap& corrections, std::string_view key) {
+  std::optional<YamlMap> m = corrections.optional_map(key);
+  if (!m) return std::nullopt;
+  ChannelCorrection c;
+  for (const auto& [name, field] : correction_scalars(c))
+    m->read(name, *field);
+  if (m->has("creep_eigenvalues")) m->read_sequence("creep_eigenvalues", c.creep_eigenvalues);
+  if (m->has("creep_weights")) m->read_sequence("creep_weights", c.creep_weights);
+  m->finish();
+  return c;
+}
+
 TransducerModel read_model(YamlMap root) {
   const int version = root.required<int>("selfsense_model");
   if (version != kModelFormatVersion) {
@@ -148,6 +182,11 @@ TransducerModel read_model(YamlMap root) {
   } else {
     model.sensor = read_side(root, "sensor", model.sample_time);
     model.actuator = read_side(root, "actuator", model.sample_time);
+  }
+  if (auto c = root.optional_map("corrections")) {
+    model.sensed_correction = read_correction(*c, "sensed");
+    model.strain_correction = read_correction(*c, "strain");
+    c->finish();
   }
   if (root.has("fit")) static_cast<void>(root.optional_map("fit"));  // notes only
   root.finish();
@@ -212,6 +251,18 @@ void emit_vectorial(YAML::Emitter& out, const StressHysteresisModel& m) {
   out << YAML::EndMap;
 }
 
+void emit_correction(YAML::Emitter& out, const char* key, const ChannelCorrection& c) {
+  out << YAML::Key << key << YAML::Value << YAML::BeginMap;
+  for (const auto& [name, field] : correction_scalars(c)) {
+    out << YAML::Key << name << YAML::Value << *field;
+  }
+  if (!c.creep_eigenvalues.empty()) {
+    emit_sequence(out, "creep_eigenvalues", c.creep_eigenvalues);
+    emit_sequence(out, "creep_weights", c.creep_weights);
+  }
+  out << YAML::EndMap;
+}
+
 }  // namespace
 
 TransducerModel load_model(const std::filesystem::path& path) {
@@ -252,6 +303,12 @@ std::string model_to_string(const TransducerModel& model, const std::string& fit
   if (model.vectorial) emit_vectorial(out, *model.vectorial);
   if (model.sensor) emit_side(out, "sensor", *model.sensor);
   if (model.actuator) emit_side(out, "actuator", *model.actuator);
+  if (model.sensed_correction || model.strain_correction) {
+    out << YAML::Key << "corrections" << YAML::Value << YAML::BeginMap;
+    if (model.sensed_correction) emit_correction(out, "sensed", *model.sensed_correction);
+    if (model.strain_correction) emit_correction(out, "strain", *model.strain_correction);
+    out << YAML::EndMap;
+  }
   if (!fit_notes.empty()) out << YAML::Key << "fit" << YAML::Value << YAML::Load(fit_notes);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";

@@ -50,6 +50,20 @@ void add_side(Fnv1a& h, const std::optional<SideModel>& side) noexcept {
   h.add(side->history);
 }
 
+void add_correction(Fnv1a& h, const std::optional<ChannelCorrection>& c) noexcept {
+  h.add(static_cast<std::uint64_t>(c.has_value()));
+  if (!c) return;
+  for (const double x :
+       {c->gain, c->offset, c->temperature_reference_degc, c->temperature_gain_per_k,
+        c->temperature_offset_per_k, c->temperature_drive_per_k, c->stress_gain_per_pa,
+        c->drive_quadratic, c->drive_cubic, c->sensed_quadratic, c->dynamics_frequency_hz,
+        c->dynamics_damping, c->leakage_tau_s, c->delay_s}) {
+    h.add(x);
+  }
+  h.add(c->creep_eigenvalues);
+  h.add(c->creep_weights);
+}
+
 void add_vectorial_side(Fnv1a& h, const std::optional<StressHysteresisSide>& side) noexcept {
   h.add(static_cast<std::uint64_t>(side.has_value()));
   if (!side) return;
@@ -77,6 +91,8 @@ std::uint64_t parameter_hash(const TransducerModel& model) noexcept {
     add_vectorial_side(h, v.sensor);
     add_vectorial_side(h, v.actuator);
   }
+  add_correction(h, model.sensed_correction);
+  add_correction(h, model.strain_correction);
   return h.value();
 }
 

@@ -85,16 +85,34 @@ decltype(auto) dispatch(const std::variant<Affine, std::unique_ptr<Vectorial>>& 
   return f(**std::get_if<std::unique_ptr<Vectorial>>(&impl));
 }
 
+using Stages = std::optional<CorrectionStage>* [2];
+using ConstStages = const std::optional<CorrectionStage>* const[2];
+
 template <typename Impl>
-bool save_into(const Impl& impl, const ModelIdentity& identity, SavedState& out) noexcept {
+std::size_t kernel_size(const Impl& impl) noexcept {
+  return dispatch(impl, [](const auto& m) { return m.state_size(); });
+}
+
+// The kernel's state first, then each correction stage's.
+template <typename Impl>
+bool save_into(const Impl& impl, ConstStages& stages, const ModelIdentity& identity,
+               SavedState& out) noexcept {
   if (out.values.size() != identity.state_size) return false;
-  dispatch(impl, [&](const auto& m) { m.save_state(out.values); });
+  const std::size_t n = kernel_size(impl);
+  const std::span<double> all(out.values);
+  dispatch(impl, [&](const auto& m) { m.save_state(all.first(n)); });
+  std::size_t at = n;
+  for (const auto* stage : stages) {
+    if (!stage->has_value()) continue;
+    (*stage)->save_state(all.subspan(at, CorrectionStage::state_size()));
+    at += CorrectionStage::state_size();
+  }
   out.identity = identity;
   return true;
 }
 
 template <typename Impl>
-RestoreResult restore_from(Impl& impl, const ModelIdentity& identity,
+RestoreResult restore_from(Impl& impl, Stages& stages, const ModelIdentity& identity,
                            const SavedState& in) noexcept {
   if (in.identity.structure != identity.structure ||
       in.identity.parameter_hash != identity.parameter_hash) {
@@ -103,8 +121,36 @@ RestoreResult restore_from(Impl& impl, const ModelIdentity& identity,
   if (in.identity.state_size != identity.state_size || in.values.size() != identity.state_size) {
     return RestoreResult::kWrongSize;
   }
-  dispatch(impl, [&](auto& m) { m.restore_state(in.values); });
+  const std::size_t n = kernel_size(impl);
+  const std::span<const double> all(in.values);
+  dispatch(impl, [&](auto& m) { m.restore_state(all.first(n)); });
+  std::size_t at = n;
+  for (auto* stage : stages) {
+    if (!stage->has_value()) continue;
+    (*stage)->restore_state(all.subspan(at, CorrectionStage::state_size()));
+    at += CorrectionStage::state_size();
+  }
   return RestoreResult::kOk;
+}
+
+std::optional<CorrectionStage> stage_for(const std::optional<ChannelCorrection>& c, double ts) {
+  if (!c || c->empty()) return std::nullopt;
+  return CorrectionStage(*c, ts);
+}
+
+double reference_temperature(const TransducerModel& model) noexcept {
+  if (model.sensed_correction) return model.sensed_correction->temperature_reference_degc;
+  if (model.strain_correction) return model.strain_correction->temperature_reference_degc;
+  return 25.0;
+}
+
+double coupling_of(const std::optional<SideModel>& side) noexcept {
+  return (side && !side->linear_gains.empty()) ? side->linear_gains.front() : 0.0;
+}
+
+std::size_t stages_size(const std::optional<CorrectionStage>& a,
+                        const std::optional<CorrectionStage>& b) noexcept {
+  return (a ? CorrectionStage::state_size() : 0) + (b ? CorrectionStage::state_size() : 0);
 }
 
 // One step behind the input gate (header comment): a rejected sample advances the kernel with
@@ -129,11 +175,6 @@ Out gated_step(const detail::InputGate& gate, detail::HeldInputs& held, Out& las
   held = {first, second, true};
   last = out;
   return out;
-}
-
-template <typename Impl>
-std::size_t state_size_of(const Impl& impl) noexcept {
-  return dispatch(impl, [](const auto& m) { return m.state_size(); });
 }
 
 }  // namespace
@@ -202,8 +243,18 @@ Reconstruction::Reconstruction(const TransducerModel& model, const RuntimeOption
       gate_(model.drive_range, model.sensed_range, options.range_margin),
       sample_time_(loop_sample_time(model, options)),
       identified_ts_(model.sample_time),
-      last_{0.0, kNaN, SampleStatus::kOk} {
-  identity_ = {model.structure, parameter_hash(model), state_size_of(impl_)};
+      last_{0.0, kNaN, SampleStatus::kOk},
+      sensed_fix_(stage_for(model.sensed_correction, sample_time_)),
+      strain_fix_(stage_for(model.strain_correction, sample_time_)),
+      temperature_(reference_temperature(model)),
+      sensed_coupling_(coupling_of(model.sensor)),
+      strain_coupling_(coupling_of(model.actuator)) {
+  std::string why;
+  if (model.sensed_correction && !model.sensed_correction->invertible("corrections.sensed", &why)) {
+    throw std::invalid_argument(why);
+  }
+  identity_ = {model.structure, parameter_hash(model),
+               kernel_size(impl_) + stages_size(sensed_fix_, strain_fix_)};
   scratch_.resize(identity_.state_size);
   held_.first = initial_input(model);
 }
@@ -219,12 +270,25 @@ Reconstruction::Estimate Reconstruction::step(double drive, double sensed) noexc
 }
 
 Reconstruction::Estimate Reconstruction::kernel_step(double drive, double sensed) noexcept {
-  if (auto* affine = std::get_if<Affine>(&impl_)) {
-    const Reconstructor::Estimate e = affine->step(drive, sensed);
-    return {e.stress, e.strain, SampleStatus::kOk};
+  double x = drive;
+  double y = sensed;
+  if (sensed_fix_) {
+    x = sensed_fix_->delay_drive(drive);
+    y = sensed_fix_->invert(sensed, {0.0, x, 0.0, temperature_, 0.0});
   }
-  const StressHysteresisReconstructor::Estimate e = std::get<Vectorial>(impl_)->step(drive, sensed);
-  return {e.stress, e.strain, e.status};
+  Estimate out{};
+  if (auto* affine = std::get_if<Affine>(&impl_)) {
+    const Reconstructor::Estimate e = affine->step(x, y);
+    out = {e.stress, e.strain, SampleStatus::kOk};
+  } else {
+    const StressHysteresisReconstructor::Estimate e = std::get<Vectorial>(impl_)->step(x, y);
+    out = {e.stress, e.strain, e.status};
+  }
+  if (strain_fix_) {
+    out.strain = strain_fix_->step(
+        {out.strain, x, out.stress, temperature_, y, out.strain - strain_coupling_ * out.stress});
+  }
+  return out;
 }
 
 SavedState Reconstruction::make_saved_state() const {
@@ -232,11 +296,13 @@ SavedState Reconstruction::make_saved_state() const {
 }
 
 bool Reconstruction::save_state(SavedState& out) const noexcept {
-  return save_into(impl_, identity_, out);
+  ConstStages stages{&sensed_fix_, &strain_fix_};
+  return save_into(impl_, stages, identity_, out);
 }
 
 RestoreResult Reconstruction::restore_state(const SavedState& in) noexcept {
-  return restore_from(impl_, identity_, in);
+  Stages stages{&sensed_fix_, &strain_fix_};
+  return restore_from(impl_, stages, identity_, in);
 }
 
 void Reconstruction::memory(detail::ModelMemory& out) const noexcept {
@@ -269,8 +335,14 @@ Simulation::Simulation(const TransducerModel& model, const RuntimeOptions& optio
       gate_(model.drive_range, std::nullopt, options.range_margin),
       sample_time_(loop_sample_time(model, options)),
       identified_ts_(model.sample_time),
-      last_{kNaN, kNaN, SampleStatus::kOk} {
-  identity_ = {model.structure, parameter_hash(model), state_size_of(impl_)};
+      last_{kNaN, kNaN, SampleStatus::kOk},
+      sensed_fix_(stage_for(model.sensed_correction, sample_time_)),
+      strain_fix_(stage_for(model.strain_correction, sample_time_)),
+      temperature_(reference_temperature(model)),
+      sensed_coupling_(coupling_of(model.sensor)),
+      strain_coupling_(coupling_of(model.actuator)) {
+  identity_ = {model.structure, parameter_hash(model),
+               kernel_size(impl_) + stages_size(sensed_fix_, strain_fix_)};
 }
 
 Simulation::Output Simulation::step(double drive, double stress) noexcept {
@@ -279,12 +351,24 @@ Simulation::Output Simulation::step(double drive, double stress) noexcept {
 }
 
 Simulation::Output Simulation::kernel_step(double drive, double stress) noexcept {
+  Output out{};
   if (auto* affine = std::get_if<Affine>(&impl_)) {
     const ForwardModel::Output o = affine->step(drive, stress);
-    return {o.sensed, o.strain, SampleStatus::kOk};
+    out = {o.sensed, o.strain, SampleStatus::kOk};
+  } else {
+    const StressHysteresisForward::Output o = std::get<Vectorial>(impl_)->step(drive, stress);
+    out = {o.sensed, o.strain, SampleStatus::kOk};
   }
-  const StressHysteresisForward::Output o = std::get<Vectorial>(impl_)->step(drive, stress);
-  return {o.sensed, o.strain, SampleStatus::kOk};
+  const double base_sensed = out.sensed;
+  if (sensed_fix_) {
+    out.sensed = sensed_fix_->step({out.sensed, drive, stress, temperature_, base_sensed,
+                                    out.sensed - sensed_coupling_ * stress});
+  }
+  if (strain_fix_) {
+    out.strain = strain_fix_->step({out.strain, drive, stress, temperature_, base_sensed,
+                                    out.strain - strain_coupling_ * stress});
+  }
+  return out;
 }
 
 SavedState Simulation::make_saved_state() const {
@@ -292,11 +376,13 @@ SavedState Simulation::make_saved_state() const {
 }
 
 bool Simulation::save_state(SavedState& out) const noexcept {
-  return save_into(impl_, identity_, out);
+  ConstStages stages{&sensed_fix_, &strain_fix_};
+  return save_into(impl_, stages, identity_, out);
 }
 
 RestoreResult Simulation::restore_state(const SavedState& in) noexcept {
-  return restore_from(impl_, identity_, in);
+  Stages stages{&sensed_fix_, &strain_fix_};
+  return restore_from(impl_, stages, identity_, in);
 }
 
 }  // namespace selfsense::models

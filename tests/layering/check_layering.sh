@@ -17,6 +17,7 @@ declare -A allowed=(
   [control]="control"
   [plant]="plant"
   [identification]="identification models operators"
+  [diagnosis]="diagnosis identification models operators"
   [io]="io"
   [model_io]="model_io models operators io"
   [plant_io]="plant_io plant io"
@@ -24,7 +25,7 @@ declare -A allowed=(
   [daemon]="daemon runtime models operators control io model_io"
 )
 # The math: no files, streams, threads, clocks, sockets or file formats.
-math="operators models control plant identification"
+math="operators models control plant identification diagnosis"
 forbidden_system='fstream|iostream|filesystem|thread|mutex|condition_variable|future|chrono|cstdio|yaml-cpp/.*|nlohmann/.*|sys/.*|unistd\.h|fcntl\.h|pthread\.h'
 
 violations=0

@@ -23,6 +23,9 @@
 //     stress_range: [min, max]           #   (stress_hysteresis.hpp); bracket of the solver
 //     sensor: {base, stress, linear, quadratic, offset}
 //     actuator: {base, stress, linear, quadratic, offset}
+//   corrections:                         # physics added by `selfsense diagnose`, optional
+//     sensed: {gain, offset, leakage_tau_s, delay_s, ...}   # (models/channel_correction.hpp)
+//     strain: {gain, creep_eigenvalues, creep_weights, dynamics_frequency_hz, ...}
 //   fit: {...}                           # free-form notes written by identify, not read back
 // Loading is strict: unknown keys, missing fields, wrong types and parameters that make an
 // operator non-invertible are errors naming file, line and key path.

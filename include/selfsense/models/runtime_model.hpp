@@ -26,6 +26,12 @@
 // adopt_state() at a cycle boundary (plays and lags where thresholds match, re-initialised from
 // the last input otherwise); then the loop exchanges one pointer.
 //
+// Corrections a diagnosis added (channel_correction.hpp) run after the kernel: forward on both
+// channels in Simulation; in Reconstruction the sensed channel's correction is inverted before
+// the kernel (its delay moves to the drive) and the strain correction runs forward on S_hat.
+// Their state follows the kernel's in a SavedState; a hot swap starts them afresh. The
+// temperature they may use is set with set_temperature() (default: their reference).
+//
 // Real-time safe after construction: step(), save_state(), restore_state(), adopt_state() are
 // noexcept and allocate nothing. Construction and make_saved_state() allocate.
 #pragma once
@@ -36,6 +42,7 @@
 #include <variant>
 #include <vector>
 
+#include "selfsense/models/channel_correction.hpp"
 #include "selfsense/models/model_identity.hpp"
 #include "selfsense/models/reconstructor.hpp"
 #include "selfsense/models/sample_status.hpp"
@@ -102,6 +109,8 @@ class Reconstruction final {
   [[nodiscard]] double identified_sample_time() const noexcept { return identified_ts_; }
   [[nodiscard]] bool rediscretised() const noexcept { return sample_time_ != identified_ts_; }
   [[nodiscard]] bool has_strain() const noexcept;
+  // [degC], for temperature terms of the corrections; held until set again.
+  void set_temperature(double degc) noexcept { temperature_ = degc; }
 
   [[nodiscard]] SavedState make_saved_state() const;  // allocates
   // False (and nothing written) if `out` was not made for this model's state size.
@@ -126,6 +135,11 @@ class Reconstruction final {
   Estimate last_{};
   StatusCounts counts_{};
   std::vector<double> scratch_{};  // sized once: adopt_state() builds the new state here
+  std::optional<CorrectionStage> sensed_fix_{};
+  std::optional<CorrectionStage> strain_fix_{};
+  double temperature_{25.0};
+  double sensed_coupling_{0.0};  // of the stress, for the corrections' response r = y - g T
+  double strain_coupling_{0.0};
 };
 
 class Simulation final {
@@ -146,6 +160,8 @@ class Simulation final {
 
   // stress: T [Pa] (0 for the free actuator).
   Output step(double drive, double stress) noexcept;
+  // [degC], for temperature terms of the corrections; held until set again.
+  void set_temperature(double degc) noexcept { temperature_ = degc; }
 
   [[nodiscard]] const StatusCounts& counts() const noexcept { return counts_; }
   [[nodiscard]] const ModelIdentity& identity() const noexcept { return identity_; }
@@ -170,6 +186,11 @@ class Simulation final {
   detail::HeldInputs held_{};  // the last accepted inputs
   Output last_{};
   StatusCounts counts_{};
+  std::optional<CorrectionStage> sensed_fix_{};
+  std::optional<CorrectionStage> strain_fix_{};
+  double temperature_{25.0};
+  double sensed_coupling_{0.0};  // of the stress, for the corrections' response r = y - g T
+  double strain_coupling_{0.0};
 };
 
 }  // namespace selfsense::models

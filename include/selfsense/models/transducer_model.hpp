@@ -27,6 +27,7 @@
 #include <string_view>
 #include <vector>
 
+#include "selfsense/models/channel_correction.hpp"
 #include "selfsense/models/geometry.hpp"
 #include "selfsense/models/side_model.hpp"
 #include "selfsense/models/stress_hysteresis.hpp"
@@ -68,6 +69,10 @@ struct TransducerModel {
   std::optional<Geometry> geometry{};                // for terminal quantities
   std::optional<InputRange> drive_range{};           // x: E (field drive) or D (charge drive)
   std::optional<InputRange> sensed_range{};          // y: D (field drive) or E (charge drive)
+  // Physics a diagnosis added after the sides (channel_correction.hpp); none in identified
+  // models.
+  std::optional<ChannelCorrection> sensed_correction{};
+  std::optional<ChannelCorrection> strain_correction{};
 
   [[nodiscard]] Drive drive() const noexcept { return drive_of(structure); }
   // The operator parameters and couplings are valid and the sample times agree.

@@ -1,0 +1,90 @@
+// Diagnosis of a transducer model against a recording (selfsense diagnose, docs/diagnose.md):
+// locate where they differ, name the physics the model leaves out, model it, show the fit
+// improve. Pure math: signals in, a result and the improved model out.
+//
+// For each output channel the model has and the recording references (D, S):
+//   1. residual e = recorded - model; correlation tests and large segments (residual_tests.hpp)
+//   2. every candidate effect of physics.md that the channel can show is fitted as a
+//      correction (models/channel_correction.hpp, identification/correction_fit.hpp) on the
+//      fitting blocks only (alternate tenths of the record), and judged on the other blocks:
+//      explains = 1 - SSE_after / SSE_before there
+//   3. the best candidate is accepted when it explains at least `min_explains` of the held-out
+//      residual, overall and in the median held-out block (a term that fits one stretch by
+//      chance is not named); of candidates explaining about as much, the simplest wins; candidates
+//      that explain nearly as much are reported as alternatives; then the search repeats on what is
+//      left (several effects in turn), refitting the accepted terms jointly with each new candidate
+//   4. the accepted corrections go into the model, which the runtime runs per sample.
+// A model that already carries corrections is diagnosed from its sides alone (its corrections
+// are found again if still needed).
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "selfsense/diagnosis/residual_tests.hpp"
+#include "selfsense/models/transducer_model.hpp"
+
+namespace selfsense::diagnosis {
+
+// A recording in field quantities; empty spans: channel absent.
+struct Signals {
+  std::span<const double> drive{};        // E (field drive) or D (charge drive)
+  std::span<const double> sensed{};       // D (or E)
+  std::span<const double> strain{};       // S
+  std::span<const double> stress{};       // T [Pa]
+  std::span<const double> temperature{};  // [degC]
+  double sample_time{0.0};
+};
+
+struct Options {
+  double min_explains{0.3};       // share of held-out residual variance an effect must remove
+  double alternative_share{0.8};  // alternatives: explain at least this share of the best's
+  // A simpler candidate wins when the residual it leaves is at most this factor of the best's.
+  double parsimony_ratio{1.25};
+  std::size_t max_effects{4};  // per channel
+  std::size_t blocks{10};      // alternate blocks for fitting and judging
+};
+
+struct Finding {
+  std::string effect{};   // physics.md word
+  std::string channel{};  // "D" / "S" (or "E" for charge drive)
+  std::vector<Segment> where{};
+  double explains{0.0};
+  std::string evidence{};
+  std::vector<std::string> alternatives{};  // other effects explaining nearly as much
+  std::string feature_name{};
+  std::vector<double> feature{};  // the explaining feature per sample
+};
+
+struct ChannelResult {
+  std::string channel{};
+  std::vector<double> recorded{};
+  std::vector<double> before{};
+  std::vector<double> after{};
+  std::vector<Segment> located{};
+  CorrelationTest test_before{};
+  CorrelationTest test_after{};
+};
+
+struct Result {
+  bool mismatch{false};
+  std::vector<Finding> findings{};
+  std::vector<ChannelResult> channels{};
+  models::TransducerModel improved{};
+};
+
+// Throws std::invalid_argument on unusable signals (no drive, sizes differ, no referenced
+// output the model has).
+[[nodiscard]] Result diagnose(const models::TransducerModel& model, const Signals& signals,
+                              const Options& options = {});
+
+// The model's outputs (sensed, strain) over a recording, per sample through the runtime model.
+struct Outputs {
+  std::vector<double> sensed{};
+  std::vector<double> strain{};
+};
+[[nodiscard]] Outputs simulate(const models::TransducerModel& model, const Signals& signals);
+
+}  // namespace selfsense::diagnosis

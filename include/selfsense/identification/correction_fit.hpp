@@ -1,0 +1,65 @@
+// Identification of the physics a diagnosis adds to one output channel
+// (models/channel_correction.hpp). The terms before the filters are linear in their
+// coefficients, and the filters (dynamics, leakage, delay) are linear time-invariant, so for
+// fixed filter parameters the corrected output is
+//   out = F[y] + sum_i c_i F[phi_i]
+// with phi_i the term regressors (y, 1, (theta - theta_ref) y, x^2, lag outputs of y, ...) and F
+// the filter chain: least squares for c. Filter parameters not given are searched on a
+// logarithmic grid, each point solved by least squares; the grid point is chosen by the error on
+// the fitting rows only (the caller keeps other rows to judge the result).
+//
+// Not real-time code: allocates O(samples x terms).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "selfsense/models/channel_correction.hpp"
+
+namespace selfsense::identification {
+
+enum class CorrectionTerm : std::uint8_t {
+  kOffset,       // gain and offset
+  kTemperature,  // gain and offset per kelvin
+  kStress,       // gain per pascal
+  kDrivePolynomial,
+  kSensedQuadratic,
+  kCreep,     // log-spaced lags of y
+  kDynamics,  // searched: f0, zeta
+  kLeakage,   // searched: tau
+  kDelay,     // searched: delay
+};
+
+struct CorrectionSignals {
+  std::span<const double> y{};            // the model's output of the channel
+  std::span<const double> recorded{};     // the recorded channel
+  std::span<const double> drive{};        // x
+  std::span<const double> stress{};       // T [Pa]; empty: 0
+  std::span<const double> temperature{};  // [degC]; empty: the reference
+  std::span<const double> sensed{};       // the model's sensed output; empty: 0
+  std::span<const double> response{};     // y - coupling T; empty: y
+  double sample_time{0.0};                // [s]
+  double temperature_reference_degc{25.0};
+};
+
+struct CorrectionFit {
+  models::ChannelCorrection correction{};
+  std::vector<double> output{};  // the corrected output over the whole recording
+  double fit_sse{0.0};           // sum of squared errors on the fitting rows
+};
+
+// Fits the given terms; `start` carries filter parameters already chosen (they are kept, not
+// searched again) and is otherwise ignored. fit_rows[k]: sample k may be used for fitting.
+// Throws std::invalid_argument on mismatched sizes or no fitting rows.
+[[nodiscard]] CorrectionFit fit_correction(const CorrectionSignals& signals,
+                                           std::span<const CorrectionTerm> terms,
+                                           const models::ChannelCorrection& start,
+                                           const std::vector<bool>& fit_rows);
+
+// Runs a correction over a whole recording (the runtime's CorrectionStage, so the figures are
+// those the loop will see).
+[[nodiscard]] std::vector<double> apply_correction(const CorrectionSignals& signals,
+                                                   const models::ChannelCorrection& correction);
+
+}  // namespace selfsense::identification

@@ -1,0 +1,131 @@
+// Physics a diagnosis adds to one output channel of a transducer model (selfsense diagnose,
+// docs/diagnose.md): terms after the model's own output y of that channel, then linear filters.
+//
+//   v = y + gain y + offset                                      offset (gain and offset error)
+//         + temperature_gain (theta - theta_ref) y
+//         + temperature_offset (theta - theta_ref)               temperature_dependence
+//         + temperature_drive (theta - theta_ref) x
+//         + stress_gain T r                                      stress_dependence
+//         + drive_quadratic x^2 + drive_cubic x^3                permittivity_nonlinearity
+//         + sensed_quadratic s^2                                 electrostriction (S ~ P^2, P ~ D)
+//         + sum_j creep_weights_j (z_j - r_0)                    creep (eq. 28: K = L[H])
+//   z_j[k] = z_j[k-1] + (1 - exp(-lambda_j Ts)) (r[k] - z_j[k-1]),  z_j = r_0 = r at the start
+//   w = second-order low-pass of v, unity DC gain, f0 and zeta    dynamics
+//       (bilinear transform prewarped at f0)
+//   m[k] = g m[k-1] + c (w[k] - w[k-1]),  g = exp(-Ts/tau), c = (1 - g) tau / Ts,  m = w at the
+//       start                                                     charge_leakage
+//   out[k] = m(k Ts - delay)  (linear interpolation, delay <= 64 samples)        delay
+// x: the drive (E for field drive), T: stress [Pa], theta: temperature [degC], s: the model's
+// sensed output (D), r = y - coupling T the channel's response to the drive alone (so a coupling
+// that changes with stress, d(T) = d (1 + k T), is k T r). Units: gain, temperature_gain [1/K],
+// stress_gain [1/Pa] relative; offset and the polynomial terms in the channel's unit.
+//
+// Reconstruction needs the inverse on the sensed channel: the leakage is undone
+// (w[k] = w[k-1] + (m[k] - g m[k-1]) / c), a delay moves to the drive, and the additive and
+// gain terms that do not depend on T are solved for y. Terms that depend on T or on y's history
+// (stress_gain, creep, dynamics) make the sensor side non-invertible in closed form:
+// invertible() says so and the Reconstruction refuses such a model by name.
+//
+// Real-time safe after construction: step(), invert(), save/restore are noexcept and allocate
+// nothing.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace selfsense::models {
+
+struct ChannelCorrection {
+  double gain{0.0};
+  double offset{0.0};
+  double temperature_reference_degc{25.0};
+  double temperature_gain_per_k{0.0};
+  double temperature_offset_per_k{0.0};
+  double temperature_drive_per_k{0.0};
+  double stress_gain_per_pa{0.0};
+  double drive_quadratic{0.0};
+  double drive_cubic{0.0};
+  double sensed_quadratic{0.0};
+  std::vector<double> creep_eigenvalues{};  // [1/s]
+  std::vector<double> creep_weights{};
+  double dynamics_frequency_hz{0.0};  // 0: none
+  double dynamics_damping{0.0};
+  double leakage_tau_s{0.0};  // 0: none
+  double delay_s{0.0};        // 0: none
+
+  // Every value finite, sizes agree, dynamics_damping > 0 with a frequency, taus and delay
+  // >= 0; names the key under `prefix` ("corrections.sensed.leakage_tau_s: ...").
+  [[nodiscard]] bool is_valid(const std::string& prefix, std::string* why) const;
+  // Closed-form inverse exists (header comment); otherwise *why names the term.
+  [[nodiscard]] bool invertible(const std::string& prefix, std::string* why) const;
+  [[nodiscard]] bool empty() const noexcept;
+};
+
+inline constexpr std::size_t kMaxCorrectionDelaySamples{64};
+inline constexpr std::size_t kMaxCorrectionCreep{12};
+
+class CorrectionStage {
+ public:
+  struct Inputs {
+    double y{0.0};            // the model's output of this channel (forward) ...
+    double drive{0.0};        // x
+    double stress{0.0};       // T [Pa]
+    double temperature{0.0};  // [degC]
+    double sensed{0.0};       // the model's sensed output (electrostriction term)
+    double response{0.0};     // y - coupling T (stress term)
+  };
+
+  // Throws std::invalid_argument if the correction is invalid, the delay exceeds
+  // kMaxCorrectionDelaySamples at this sample time, or there are too many creep terms.
+  CorrectionStage(const ChannelCorrection& correction, double sample_time);
+
+  // Forward: the corrected output for this sample.
+  double step(const Inputs& in) noexcept;
+  // Sensed-channel inverse (only for invertible() corrections): the model output y that
+  // explains the measurement `measured` at this sample; `in.y` is ignored and the drive must
+  // already be delayed by the caller (delay_samples()).
+  double invert(double measured, const Inputs& in) noexcept;
+  // The drive delayed by this channel's delay (reconstruction feeds it to the kernel).
+  double delay_drive(double drive) noexcept;
+
+  [[nodiscard]] static constexpr std::size_t state_size() noexcept { return kStateSize; }
+  void save_state(std::span<double> out) const noexcept;
+  void restore_state(std::span<const double> in) noexcept;
+
+ private:
+  static constexpr std::size_t kLine = kMaxCorrectionDelaySamples + 2;
+  static constexpr std::size_t kStateSize = 12 + kMaxCorrectionCreep + 2 * kLine;
+
+  double terms(const Inputs& in) const noexcept;  // the additive/gain terms except creep
+  double filters(double v) noexcept;              // dynamics, leakage, delay
+  double delayed(double value) noexcept;
+
+  ChannelCorrection c_;
+  std::array<double, kMaxCorrectionCreep> alpha_{};  // 1 - exp(-lambda Ts)
+  std::size_t creep_count_{0};
+  // Dynamics: w[k] = b0 v[k] + b1 v[k-1] + b2 v[k-2] - a1 w[k-1] - a2 w[k-2].
+  double b0_{1.0}, b1_{0.0}, b2_{0.0}, a1_{0.0}, a2_{0.0};
+  bool dynamics_{false};
+  double leak_g_{0.0}, leak_c_{1.0};
+  bool leakage_{false};
+  std::size_t delay_whole_{0};
+  double delay_frac_{0.0};
+  bool delay_{false};
+  // State (saved in this order): started, y0, v1, v2, w1, w2, m, w_prev, head, drive_head,
+  // drive_started, spare; creep z; the output and drive delay lines (rings).
+  bool started_{false};
+  double y0_{0.0};
+  double v1_{0.0}, v2_{0.0}, w1_{0.0}, w2_{0.0};
+  double m_{0.0}, w_prev_{0.0};
+  std::array<double, kMaxCorrectionCreep> z_{};
+  std::array<double, kLine> line_{};
+  std::size_t head_{0};
+  std::array<double, kLine> drive_line_{};
+  std::size_t drive_head_{0};
+  bool drive_started_{false};
+};
+
+}  // namespace selfsense::models

@@ -1,0 +1,477 @@
+#include "selfsense/diagnosis/diagnosis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+#include "selfsense/identification/correction_fit.hpp"
+#include "selfsense/models/runtime_model.hpp"
+
+namespace selfsense::diagnosis {
+namespace {
+
+using identification::CorrectionTerm;
+using models::ChannelCorrection;
+
+enum class Needs : std::uint8_t { kNothing, kTemperature, kStress, kSensed };
+
+// The effects of physics.md a channel correction can add, and the terms that model each.
+struct Candidate {
+  const char* effect;
+  std::vector<CorrectionTerm> terms;
+  bool on_sensed;  // the reconstruction can invert it on the sensed channel
+  bool on_strain;
+  Needs needs;
+};
+
+const std::vector<Candidate>& candidates() {
+  static const std::vector<Candidate> list{
+      {"offset", {CorrectionTerm::kOffset}, true, true, Needs::kNothing},
+      {"charge_leakage",
+       {CorrectionTerm::kLeakage, CorrectionTerm::kOffset},
+       true,
+       false,
+       Needs::kNothing},
+      {"delay", {CorrectionTerm::kDelay}, true, true, Needs::kNothing},
+      {"dynamics", {CorrectionTerm::kDynamics}, false, true, Needs::kNothing},
+      {"creep", {CorrectionTerm::kCreep, CorrectionTerm::kOffset}, false, true, Needs::kNothing},
+      {"temperature_dependence",
+       {CorrectionTerm::kTemperature, CorrectionTerm::kOffset},
+       true,
+       true,
+       Needs::kTemperature},
+      {"stress_dependence",
+       {CorrectionTerm::kStress, CorrectionTerm::kOffset},
+       false,
+       true,
+       Needs::kStress},
+      {"permittivity_nonlinearity",
+       {CorrectionTerm::kDrivePolynomial},
+       true,
+       false,
+       Needs::kNothing},
+      {"electrostriction", {CorrectionTerm::kSensedQuadratic}, false, true, Needs::kSensed},
+  };
+  return list;
+}
+
+double range_of(std::span<const double> x) {
+  if (x.empty()) return 0.0;
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  return *hi - *lo;
+}
+
+// printf-style "%.3g", "%.0f" and "%%" only (the math libraries do no stdio).
+std::string format(const char* fmt, double a, double b = 0.0, double c = 0.0) {
+  const double args[3] = {a, b, c};
+  std::size_t next = 0;
+  std::ostringstream out;
+  for (const char* p = fmt; *p != '\0'; ++p) {
+    if (*p != '%') {
+      out << *p;
+      continue;
+    }
+    ++p;
+    if (*p == '%') {
+      out << '%';
+      continue;
+    }
+    int digits = 6;
+    if (*p == '.') {
+      digits = 0;
+      for (++p; *p >= '0' && *p <= '9'; ++p)
+        digits = digits * 10 + (*p - '0');
+    }
+    const double v = next < 3 ? args[next++] : 0.0;
+    if (*p == 'f') {
+      out << std::fixed << std::setprecision(digits) << v << std::defaultfloat;
+    } else {
+      out << std::setprecision(std::max(digits, 1)) << v;
+    }
+  }
+  return out.str();
+}
+
+struct ChannelData {
+  std::string name;
+  bool sensed{false};
+  std::span<const double> recorded;
+  std::vector<double> base;
+  double coupling{0.0};  // of the stress in the model's side
+};
+
+// Share of the residual variance removed in each held-out block; the median is the figure a
+// candidate must reach (one block it fits by chance does not carry it).
+double median_block_explains(std::span<const double> recorded, const std::vector<double>& before,
+                             const std::vector<double>& after, const std::vector<bool>& fit_rows,
+                             std::size_t blocks) {
+  const std::size_t n = recorded.size();
+  std::vector<double> share;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t lo = b * n / blocks;
+    const std::size_t hi = (b + 1) * n / blocks;
+    if (lo >= hi || fit_rows[lo]) continue;
+    double e0 = 0.0;
+    double e1 = 0.0;
+    for (std::size_t k = lo; k < hi; ++k) {
+      e0 += (recorded[k] - before[k]) * (recorded[k] - before[k]);
+      e1 += (recorded[k] - after[k]) * (recorded[k] - after[k]);
+    }
+    share.push_back(e0 > 0.0 ? 1.0 - e1 / e0 : 0.0);
+  }
+  if (share.empty()) return 0.0;
+  std::sort(share.begin(), share.end());
+  return share[share.size() / 2];
+}
+
+double held_out_sse(std::span<const double> recorded, const std::vector<double>& model,
+                    const std::vector<bool>& fit_rows) {
+  double sse = 0.0;
+  for (std::size_t k = 0; k < recorded.size(); ++k) {
+    if (fit_rows[k]) continue;
+    const double e = recorded[k] - model[k];
+    sse += e * e;
+  }
+  return sse;
+}
+
+// Time since the drive last moved by more than 5 % of its range, log10 seconds.
+std::vector<double> log_time_since_step(std::span<const double> x, double ts) {
+  std::vector<double> out(x.size());
+  const double step = 0.05 * range_of(x);
+  double anchor = x.empty() ? 0.0 : x[0];
+  std::size_t since = 0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (std::abs(x[k] - anchor) > step) {
+      anchor = x[k];
+      since = k;
+    }
+    out[k] = std::log10(static_cast<double>(k - since + 1) * ts);
+  }
+  return out;
+}
+
+std::vector<double> rate_of(std::span<const double> x, double ts) {
+  std::vector<double> out(x.size(), 0.0);
+  for (std::size_t k = 1; k < x.size(); ++k)
+    out[k] = (x[k] - x[k - 1]) / ts;
+  if (out.size() > 1) out[0] = out[1];
+  return out;
+}
+
+void describe(Finding& f, const ChannelCorrection& c, const ChannelData& ch, const Signals& s,
+              const std::vector<double>& before, const std::vector<double>& after) {
+  const double range = range_of(ch.recorded);
+  const double pct = range > 0.0 ? 100.0 / range : 0.0;
+  double largest = 0.0;
+  for (std::size_t k = 0; k < before.size(); ++k) {
+    largest = std::max(largest, std::abs(after[k] - before[k]));
+  }
+  const std::string tail = format(
+      "; modelled, it removes %.0f %% of the residual variance on "
+      "held-out blocks (largest change %.2g %% of range)",
+      100.0 * f.explains, largest * pct);
+  const std::string& n = ch.name;
+  if (f.effect == "offset") {
+    f.evidence = "the recorded " + n +
+                 format(" is offset by %.3g %% of its range and scaled by %.4g", c.offset * pct,
+                        1.0 + c.gain) +
+                 tail;
+    f.feature_name = "model output";
+    f.feature = before;
+  } else if (f.effect == "charge_leakage") {
+    f.evidence = "the measured " + n +
+                 format(
+                     " forgets its charge with a time constant of %.3g s (charge amplifier "
+                     "feedback or insulation resistance)",
+                     c.leakage_tau_s) +
+                 tail;
+    f.feature_name = "time [s]";
+    f.feature.resize(before.size());
+    for (std::size_t k = 0; k < before.size(); ++k) {
+      f.feature[k] = static_cast<double>(k) * s.sample_time;
+    }
+  } else if (f.effect == "delay") {
+    f.evidence = "the recorded " + n +
+                 format(" lags the model by %.3g samples (%.3g ms): channels sampled out of step",
+                        c.delay_s / s.sample_time, c.delay_s * 1e3) +
+                 tail;
+    f.feature_name = "rate of the drive [1/s]";
+    f.feature = rate_of(s.drive, s.sample_time);
+  } else if (f.effect == "dynamics") {
+    f.evidence = "the recorded " + n +
+                 format(
+                     " rings and lags at fast changes like a resonance at %.4g Hz with %.2g "
+                     "damping (inertia of stack and load)",
+                     c.dynamics_frequency_hz, c.dynamics_damping) +
+                 tail;
+    f.feature_name = "rate of the drive [1/s]";
+    f.feature = rate_of(s.drive, s.sample_time);
+  } else if (f.effect == "creep") {
+    double total = 0.0;
+    for (const double w : c.creep_weights)
+      total += w;
+    const double decades =
+        c.creep_eigenvalues.empty()
+            ? 1.0
+            : std::max(1.0, std::log10(c.creep_eigenvalues.back() / c.creep_eigenvalues.front()));
+    f.evidence = "after steps of the drive the recorded " + n +
+                 format(
+                     " keeps moving by %.2g %% of the step per decade of time (%.2g decades "
+                     "of lags)",
+                     100.0 * total / decades, decades) +
+                 tail;
+    f.feature_name = "log10 time since the drive last stepped [s]";
+    f.feature = log_time_since_step(s.drive, s.sample_time);
+  } else if (f.effect == "temperature_dependence") {
+    f.evidence = "the recorded " + n +
+                 format(
+                     " follows the temperature: gain %.3g %%/K, offset %.3g %% of range/K "
+                     "over %.3g K",
+                     100.0 * c.temperature_gain_per_k, c.temperature_offset_per_k * pct,
+                     range_of(s.temperature)) +
+                 tail;
+    f.feature_name = "temperature [degC]";
+    f.feature.assign(s.temperature.begin(), s.temperature.end());
+  } else if (f.effect == "stress_dependence") {
+    f.evidence = "the coupling of " + n +
+                 format(" changes with stress by %.3g %% per MPa over %.3g MPa",
+                        100.0 * c.stress_gain_per_pa * 1e6, range_of(s.stress) * 1e-6) +
+                 tail;
+    f.feature_name = "stress T [Pa]";
+    f.feature.assign(s.stress.begin(), s.stress.end());
+  } else if (f.effect == "permittivity_nonlinearity") {
+    const double x = std::max(std::abs(*std::max_element(s.drive.begin(), s.drive.end())),
+                              std::abs(*std::min_element(s.drive.begin(), s.drive.end())));
+    f.evidence =
+        "the recorded " + n +
+        format(
+            " curves with the drive beyond the model (quadratic and cubic terms "
+            "reach %.3g %% of range at the largest drive)",
+            (std::abs(c.drive_quadratic) * x * x + std::abs(c.drive_cubic) * x * x * x) * pct) +
+        tail;
+    f.feature_name = "drive";
+    f.feature.assign(s.drive.begin(), s.drive.end());
+  } else if (f.effect == "electrostriction") {
+    f.evidence = "the recorded " + n +
+                 format(" follows the square of the polarization (Q = %.3g per (C/m^2)^2)",
+                        c.sensed_quadratic) +
+                 tail;
+    f.feature_name = "sensed output squared";
+    f.feature = before;
+  }
+}
+
+double coupling_of(const std::optional<models::SideModel>& side) {
+  return (side && !side->linear_gains.empty()) ? side->linear_gains.front() : 0.0;
+}
+
+bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, bool has_sensed) {
+  if (ch.sensed ? !c.on_sensed : !c.on_strain) return false;
+  switch (c.needs) {
+    case Needs::kTemperature:
+      return range_of(s.temperature) > 1.0;
+    case Needs::kStress:
+      return range_of(s.stress) > 0.0;
+    case Needs::kSensed:
+      return has_sensed;
+    case Needs::kNothing:
+      return true;
+  }
+  return true;
+}
+
+// Coefficients and searched parameters a term adds: the parsimony tie-break.
+std::size_t complexity(const std::vector<CorrectionTerm>& terms) {
+  std::size_t n = 0;
+  for (const CorrectionTerm t : terms) {
+    switch (t) {
+      case CorrectionTerm::kOffset:
+      case CorrectionTerm::kDrivePolynomial:
+      case CorrectionTerm::kDynamics:
+        n += 2;
+        break;
+      case CorrectionTerm::kTemperature:
+        n += 3;
+        break;
+      case CorrectionTerm::kCreep:
+        n += 5;
+        break;
+      default:
+        n += 1;
+        break;
+    }
+  }
+  return n;
+}
+
+std::vector<CorrectionTerm> merged(const std::vector<CorrectionTerm>& a,
+                                   const std::vector<CorrectionTerm>& b) {
+  std::vector<CorrectionTerm> out = a;
+  for (const CorrectionTerm t : b) {
+    if (std::find(out.begin(), out.end(), t) == out.end()) out.push_back(t);
+  }
+  return out;
+}
+
+}  // namespace
+
+Outputs simulate(const models::TransducerModel& model, const Signals& s) {
+  models::Simulation sim(model, models::RuntimeOptions{s.sample_time});
+  Outputs out;
+  const std::size_t n = s.drive.size();
+  out.sensed.resize(n);
+  out.strain.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!s.temperature.empty()) sim.set_temperature(s.temperature[k]);
+    const models::Simulation::Output o = sim.step(s.drive[k], s.stress.empty() ? 0.0 : s.stress[k]);
+    out.sensed[k] = o.sensed;
+    out.strain[k] = o.strain;
+  }
+  return out;
+}
+
+Result diagnose(const models::TransducerModel& model, const Signals& s, const Options& options) {
+  const std::size_t n = s.drive.size();
+  const auto sized = [n](std::span<const double> x) { return x.empty() || x.size() == n; };
+  if (n < 100 || !sized(s.sensed) || !sized(s.strain) || !sized(s.stress) ||
+      !sized(s.temperature) || !(s.sample_time > 0.0)) {
+    throw std::invalid_argument(
+        "diagnose: needs at least 100 samples of the drive, channels of equal length and a "
+        "sample time");
+  }
+  models::TransducerModel base = model;
+  base.sensed_correction.reset();
+  base.strain_correction.reset();
+  const Outputs outputs = simulate(base, s);
+  const bool field = model.drive() == models::Drive::kField;
+  const bool has_sensor = model.sensor || (model.vectorial && model.vectorial->sensor);
+  const bool has_actuator = model.actuator || (model.vectorial && model.vectorial->actuator);
+
+  std::vector<ChannelData> channels;
+  if (has_sensor && !s.sensed.empty()) {
+    channels.push_back(
+        {field ? "D" : "E", true, s.sensed, outputs.sensed, coupling_of(model.sensor)});
+  }
+  if (has_actuator && !s.strain.empty()) {
+    channels.push_back({"S", false, s.strain, outputs.strain, coupling_of(model.actuator)});
+  }
+  if (channels.empty()) {
+    throw std::invalid_argument(
+        "diagnose: the recording references none of the model's outputs (D or S)");
+  }
+
+  std::vector<bool> fit_rows(n);
+  const std::size_t blocks = std::max<std::size_t>(2, options.blocks);
+  for (std::size_t k = 0; k < n; ++k)
+    fit_rows[k] = ((k * blocks) / n) % 2 == 0;
+
+  Result result;
+  result.improved = base;
+  for (const ChannelData& ch : channels) {
+    identification::CorrectionSignals cs;
+    cs.y = ch.base;
+    cs.recorded = ch.recorded;
+    cs.drive = s.drive;
+    cs.stress = s.stress;
+    cs.temperature = s.temperature;
+    cs.sensed = has_sensor ? std::span<const double>(outputs.sensed) : std::span<const double>();
+    std::vector<double> response(ch.base);
+    if (!s.stress.empty()) {
+      for (std::size_t k = 0; k < n; ++k)
+        response[k] -= ch.coupling * s.stress[k];
+    }
+    cs.response = response;
+    cs.sample_time = s.sample_time;
+    if (!s.temperature.empty()) cs.temperature_reference_degc = s.temperature[0];
+
+    std::vector<CorrectionTerm> accepted_terms;
+    ChannelCorrection accepted;
+    std::vector<double> current = ch.base;
+    std::vector<const Candidate*> used;
+    double current_sse = held_out_sse(ch.recorded, current, fit_rows);
+
+    for (std::size_t round = 0; round < options.max_effects && current_sse > 0.0; ++round) {
+      struct Tried {
+        const Candidate* candidate;
+        identification::CorrectionFit fit;
+        double explains;
+        double typical;  // median over the held-out blocks
+      };
+      std::vector<Tried> tried;
+      for (const Candidate& c : candidates()) {
+        if (std::find(used.begin(), used.end(), &c) != used.end()) continue;
+        if (!applicable(c, ch, s, has_sensor)) continue;
+        const std::vector<CorrectionTerm> terms = merged(accepted_terms, c.terms);
+        identification::CorrectionFit fit =
+            identification::fit_correction(cs, terms, accepted, fit_rows);
+        const double sse = held_out_sse(ch.recorded, fit.output, fit_rows);
+        const double typical =
+            median_block_explains(ch.recorded, current, fit.output, fit_rows, blocks);
+        tried.push_back({&c, std::move(fit), 1.0 - sse / current_sse, typical});
+      }
+      if (tried.empty()) break;
+      std::sort(tried.begin(), tried.end(),
+                [](const Tried& a, const Tried& b) { return a.explains > b.explains; });
+      // Of the candidates explaining about as much as the best, the simplest.
+      std::size_t chosen = 0;
+      for (std::size_t i = 1; i < tried.size(); ++i) {
+        if (1.0 - tried[i].explains <= options.parsimony_ratio * (1.0 - tried.front().explains) &&
+            complexity(tried[i].candidate->terms) < complexity(tried[chosen].candidate->terms)) {
+          chosen = i;
+        }
+      }
+      std::swap(tried[0], tried[chosen]);
+      const Tried& best = tried.front();
+      if (!(best.explains >= options.min_explains && best.typical >= options.min_explains)) break;
+
+      Finding f;
+      f.effect = best.candidate->effect;
+      f.channel = ch.name;
+      f.explains = best.explains;
+      for (std::size_t i = 1; i < tried.size(); ++i) {
+        if (tried[i].explains >= options.alternative_share * best.explains) {
+          f.alternatives.emplace_back(tried[i].candidate->effect);
+        }
+      }
+      std::vector<double> change(n);
+      for (std::size_t k = 0; k < n; ++k)
+        change[k] = best.fit.output[k] - current[k];
+      f.where = large_segments(change, 1.5, 5);
+      describe(f, best.fit.correction, ch, s, current, best.fit.output);
+      result.findings.push_back(std::move(f));
+
+      accepted_terms = merged(accepted_terms, best.candidate->terms);
+      accepted = best.fit.correction;
+      used.push_back(best.candidate);
+      current = best.fit.output;
+      current_sse = held_out_sse(ch.recorded, current, fit_rows);
+    }
+
+    ChannelResult out;
+    out.channel = ch.name;
+    out.recorded.assign(ch.recorded.begin(), ch.recorded.end());
+    out.before = ch.base;
+    out.after = current;
+    std::vector<double> residual(n);
+    std::vector<double> residual_after(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      residual[k] = ch.recorded[k] - ch.base[k];
+      residual_after[k] = ch.recorded[k] - current[k];
+    }
+    out.located = large_segments(residual, 1.5, 8);
+    out.test_before = correlation_test(residual, s.drive);
+    out.test_after = correlation_test(residual_after, s.drive);
+    result.channels.push_back(std::move(out));
+    if (!accepted.empty()) {
+      (ch.sensed ? result.improved.sensed_correction : result.improved.strain_correction) =
+          accepted;
+    }
+  }
+  result.mismatch = !result.findings.empty();
+  return result;
+}
+
+}  // namespace selfsense::diagnosis

@@ -1,0 +1,378 @@
+#include "selfsense/identification/correction_fit.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace selfsense::identification {
+namespace {
+
+using models::ChannelCorrection;
+using models::CorrectionStage;
+
+double at(std::span<const double> s, std::size_t k, double fallback) noexcept {
+  return s.empty() ? fallback : s[k];
+}
+
+// One column per coefficient, in the order apply_coefficients() reads them back.
+struct Columns {
+  std::vector<std::vector<double>> phi{};
+  std::vector<double> creep_eigenvalues{};
+};
+
+std::vector<double> log_spaced(double from, double to, std::size_t per_decade) {
+  std::vector<double> out;
+  if (!(from > 0.0 && to > from)) return out;
+  const double step = 1.0 / static_cast<double>(per_decade);
+  const double first = std::log10(from);
+  const auto count = static_cast<std::size_t>(std::floor((std::log10(to) - first) / step + 1e-9));
+  for (std::size_t i = 0; i <= count; ++i) {
+    out.push_back(std::pow(10.0, first + static_cast<double>(i) * step));
+  }
+  return out;
+}
+
+Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm> terms) {
+  const std::size_t n = s.y.size();
+  Columns c;
+  const auto add = [&](auto&& f) {
+    std::vector<double> col(n);
+    for (std::size_t k = 0; k < n; ++k)
+      col[k] = f(k);
+    c.phi.push_back(std::move(col));
+  };
+  const auto dtheta = [&](std::size_t k) {
+    return at(s.temperature, k, s.temperature_reference_degc) - s.temperature_reference_degc;
+  };
+  for (const CorrectionTerm t : terms) {
+    switch (t) {
+      case CorrectionTerm::kOffset:
+        add([&](std::size_t k) { return s.y[k]; });
+        add([](std::size_t) { return 1.0; });
+        break;
+      case CorrectionTerm::kTemperature:
+        add([&](std::size_t k) { return dtheta(k) * s.y[k]; });
+        add([&](std::size_t k) { return dtheta(k); });
+        add([&](std::size_t k) { return dtheta(k) * s.drive[k]; });
+        break;
+      case CorrectionTerm::kStress:
+        add([&](std::size_t k) { return at(s.stress, k, 0.0) * at(s.response, k, s.y[k]); });
+        break;
+      case CorrectionTerm::kDrivePolynomial:
+        add([&](std::size_t k) { return s.drive[k] * s.drive[k]; });
+        add([&](std::size_t k) { return s.drive[k] * s.drive[k] * s.drive[k]; });
+        break;
+      case CorrectionTerm::kSensedQuadratic:
+        add([&](std::size_t k) {
+          const double d = at(s.sensed, k, 0.0);
+          return d * d;
+        });
+        break;
+      case CorrectionTerm::kCreep: {
+        // One lag per decade from 1/(20 Ts) (at most 1e3 1/s) down to 3 / duration.
+        const double duration = static_cast<double>(n) * s.sample_time;
+        const double fastest = std::min(1.0 / (20.0 * s.sample_time), 1.0e3);
+        c.creep_eigenvalues = log_spaced(3.0 / duration, fastest, 1);
+        if (c.creep_eigenvalues.size() > models::kMaxCorrectionCreep) {
+          c.creep_eigenvalues.erase(
+              c.creep_eigenvalues.begin(),
+              c.creep_eigenvalues.end() - static_cast<std::ptrdiff_t>(models::kMaxCorrectionCreep));
+        }
+        for (const double lambda : c.creep_eigenvalues) {
+          const double a = -std::expm1(-lambda * s.sample_time);
+          std::vector<double> col(n);
+          const double r0 = at(s.response, 0, s.y[0]);
+          double z = r0;
+          for (std::size_t k = 0; k < n; ++k) {
+            z += a * (at(s.response, k, s.y[k]) - z);
+            col[k] = z - r0;
+          }
+          c.phi.push_back(std::move(col));
+        }
+        break;
+      }
+      case CorrectionTerm::kDynamics:
+      case CorrectionTerm::kLeakage:
+      case CorrectionTerm::kDelay:
+        break;  // filters: searched, not regressors
+    }
+  }
+  return c;
+}
+
+// Coefficients back into a correction, in the order of make_columns().
+void apply_coefficients(std::span<const CorrectionTerm> terms, const Columns& columns,
+                        const Eigen::VectorXd& c, ChannelCorrection& out) {
+  Eigen::Index i = 0;
+  for (const CorrectionTerm t : terms) {
+    switch (t) {
+      case CorrectionTerm::kOffset:
+        out.gain = c[i++];
+        out.offset = c[i++];
+        break;
+      case CorrectionTerm::kTemperature:
+        out.temperature_gain_per_k = c[i++];
+        out.temperature_offset_per_k = c[i++];
+        out.temperature_drive_per_k = c[i++];
+        break;
+      case CorrectionTerm::kStress:
+        out.stress_gain_per_pa = c[i++];
+        break;
+      case CorrectionTerm::kDrivePolynomial:
+        out.drive_quadratic = c[i++];
+        out.drive_cubic = c[i++];
+        break;
+      case CorrectionTerm::kSensedQuadratic:
+        out.sensed_quadratic = c[i++];
+        break;
+      case CorrectionTerm::kCreep:
+        out.creep_eigenvalues = columns.creep_eigenvalues;
+        out.creep_weights.clear();
+        for (std::size_t j = 0; j < columns.creep_eigenvalues.size(); ++j) {
+          out.creep_weights.push_back(c[i++]);
+        }
+        break;
+      default:
+        break;
+    }
+  }
+}
+
+// The filter settings to try: the given ones, or a grid for each searched filter.
+std::vector<ChannelCorrection> filter_grid(const CorrectionSignals& s,
+                                           std::span<const CorrectionTerm> terms,
+                                           const ChannelCorrection& start) {
+  const auto has = [&](CorrectionTerm t) {
+    return std::find(terms.begin(), terms.end(), t) != terms.end();
+  };
+  ChannelCorrection fixed;
+  fixed.dynamics_frequency_hz = start.dynamics_frequency_hz;
+  fixed.dynamics_damping = start.dynamics_damping;
+  fixed.leakage_tau_s = start.leakage_tau_s;
+  fixed.delay_s = start.delay_s;
+  std::vector<ChannelCorrection> grid{fixed};
+  const auto expand = [&](auto&& set, const std::vector<double>& values) {
+    std::vector<ChannelCorrection> next;
+    for (const ChannelCorrection& g : grid) {
+      for (const double v : values) {
+        ChannelCorrection c = g;
+        set(c, v);
+        next.push_back(c);
+      }
+    }
+    grid = std::move(next);
+  };
+  const double ts = s.sample_time;
+  const double duration = static_cast<double>(s.y.size()) * ts;
+  if (has(CorrectionTerm::kLeakage) && start.leakage_tau_s == 0.0) {
+    expand([](ChannelCorrection& c, double v) { c.leakage_tau_s = v; },
+           log_spaced(std::max(20.0 * ts, duration / 1000.0), 100.0 * duration, 4));
+  }
+  if (has(CorrectionTerm::kDelay) && start.delay_s == 0.0) {
+    // Quarter samples up to 4, whole samples up to 16, then every 4 (in samples).
+    std::vector<double> delays;
+    for (int q = 1; q <= 16; ++q)
+      delays.push_back(0.25 * q * ts);
+    for (int d = 5; d <= 16; ++d)
+      delays.push_back(d * ts);
+    for (int d = 20; d <= static_cast<int>(models::kMaxCorrectionDelaySamples); d += 4) {
+      delays.push_back(d * ts);
+    }
+    expand([](ChannelCorrection& c, double v) { c.delay_s = v; }, delays);
+  }
+  if (has(CorrectionTerm::kDynamics) && start.dynamics_frequency_hz == 0.0) {
+    const double nyquist = 0.5 / ts;
+    const std::vector<double> f0 =
+        log_spaced(std::max(nyquist / 500.0, 10.0 / duration), 0.8 * nyquist, 8);
+    std::vector<ChannelCorrection> next;
+    for (const ChannelCorrection& g : grid) {
+      for (const double f : f0) {
+        for (const double zeta : {0.01, 0.02, 0.04, 0.08, 0.15, 0.3, 0.6}) {
+          ChannelCorrection c = g;
+          c.dynamics_frequency_hz = f;
+          c.dynamics_damping = zeta;
+          next.push_back(c);
+        }
+      }
+    }
+    grid = std::move(next);
+  }
+  return grid;
+}
+
+// Coordinate search around the best grid point of every searched filter parameter: each is
+// multiplied and divided by shrinking factors while the fitting error falls.
+template <typename Evaluate>
+void refine(const CorrectionSignals& s, std::span<const CorrectionTerm> terms,
+            const ChannelCorrection& start, const ChannelCorrection& best, Evaluate&& evaluate) {
+  const auto has = [&](CorrectionTerm t) {
+    return std::find(terms.begin(), terms.end(), t) != terms.end();
+  };
+  std::vector<double ChannelCorrection::*> params;
+  if (has(CorrectionTerm::kLeakage) && start.leakage_tau_s == 0.0) {
+    params.push_back(&ChannelCorrection::leakage_tau_s);
+  }
+  if (has(CorrectionTerm::kDelay) && start.delay_s == 0.0) {
+    params.push_back(&ChannelCorrection::delay_s);
+  }
+  if (has(CorrectionTerm::kDynamics) && start.dynamics_frequency_hz == 0.0) {
+    params.push_back(&ChannelCorrection::dynamics_frequency_hz);
+    params.push_back(&ChannelCorrection::dynamics_damping);
+  }
+  if (params.empty()) return;
+  ChannelCorrection current = best;
+  for (const double factor : {1.2, 1.06, 1.02, 1.005}) {
+    for (int pass = 0; pass < 6; ++pass) {
+      bool improved = false;
+      for (double ChannelCorrection::*p : params) {
+        for (const double f : {factor, 1.0 / factor}) {
+          ChannelCorrection trial = current;
+          trial.*p *= f;
+          if (trial.delay_s >
+              static_cast<double>(models::kMaxCorrectionDelaySamples) * s.sample_time) {
+            continue;
+          }
+          bool better = false;
+          try {
+            better = evaluate(trial);
+          } catch (const std::invalid_argument&) {
+            better = false;  // outside what the sample time allows
+          }
+          if (better) {
+            current = trial;
+            improved = true;
+            break;
+          }
+        }
+      }
+      if (!improved) break;
+    }
+  }
+}
+
+std::vector<double> filtered(std::span<const double> x, const ChannelCorrection& filters,
+                             double ts) {
+  CorrectionStage stage(filters, ts);
+  std::vector<double> out(x.size());
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    out[k] = stage.step({x[k], 0.0, 0.0, filters.temperature_reference_degc, 0.0, 0.0});
+  }
+  return out;
+}
+
+struct Solved {
+  Eigen::VectorXd coefficients{};
+  double sse{std::numeric_limits<double>::infinity()};
+};
+
+Solved solve(std::span<const double> target, const std::vector<std::vector<double>>& columns,
+             const std::vector<bool>& rows) {
+  const auto p = static_cast<Eigen::Index>(columns.size());
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(p, p);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(p);
+  double energy = 0.0;
+  Eigen::VectorXd row(p);
+  for (std::size_t k = 0; k < target.size(); ++k) {
+    if (!rows[k]) continue;
+    for (Eigen::Index i = 0; i < p; ++i)
+      row[i] = columns[static_cast<std::size_t>(i)][k];
+    g.selfadjointView<Eigen::Lower>().rankUpdate(row);
+    b += row * target[k];
+    energy += target[k] * target[k];
+  }
+  Solved out;
+  if (p == 0) {
+    out.sse = energy;
+    out.coefficients = Eigen::VectorXd();
+    return out;
+  }
+  g = g.selfadjointView<Eigen::Lower>();
+  Eigen::VectorXd scale = g.diagonal().cwiseSqrt();
+  for (Eigen::Index i = 0; i < p; ++i) {
+    if (!(scale[i] > 0.0)) scale[i] = 1.0;
+  }
+  Eigen::MatrixXd gs = scale.cwiseInverse().asDiagonal() * g * scale.cwiseInverse().asDiagonal();
+  gs.diagonal().array() += 1e-10;
+  const Eigen::VectorXd theta = gs.ldlt().solve(b.cwiseQuotient(scale));
+  out.coefficients = theta.cwiseQuotient(scale);
+  out.sse = std::max(
+      0.0, energy - 2.0 * out.coefficients.dot(b) + out.coefficients.dot(g * out.coefficients));
+  return out;
+}
+
+}  // namespace
+
+std::vector<double> apply_correction(const CorrectionSignals& s,
+                                     const models::ChannelCorrection& correction) {
+  CorrectionStage stage(correction, s.sample_time);
+  std::vector<double> out(s.y.size());
+  for (std::size_t k = 0; k < s.y.size(); ++k) {
+    out[k] = stage.step({s.y[k], s.drive.empty() ? 0.0 : s.drive[k], at(s.stress, k, 0.0),
+                         at(s.temperature, k, correction.temperature_reference_degc),
+                         at(s.sensed, k, 0.0), at(s.response, k, s.y[k])});
+  }
+  return out;
+}
+
+CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const CorrectionTerm> terms,
+                             const models::ChannelCorrection& start,
+                             const std::vector<bool>& fit_rows) {
+  const std::size_t n = s.y.size();
+  if (n == 0 || s.recorded.size() != n || s.drive.size() != n || fit_rows.size() != n ||
+      (!s.stress.empty() && s.stress.size() != n) ||
+      (!s.temperature.empty() && s.temperature.size() != n) ||
+      (!s.sensed.empty() && s.sensed.size() != n) ||
+      (!s.response.empty() && s.response.size() != n) || !(s.sample_time > 0.0)) {
+    throw std::invalid_argument("fit_correction: signals of mismatched size or no sample time");
+  }
+  if (std::none_of(fit_rows.begin(), fit_rows.end(), [](bool b) { return b; })) {
+    throw std::invalid_argument("fit_correction: no fitting rows");
+  }
+  const Columns columns = make_columns(s, terms);
+  Solved best;
+  ChannelCorrection best_filters;
+  const auto evaluate = [&](const ChannelCorrection& filters) {
+    const bool any_filter = !filters.empty();
+    std::vector<std::vector<double>> cols;
+    cols.reserve(columns.phi.size());
+    for (const std::vector<double>& phi : columns.phi) {
+      cols.push_back(any_filter ? filtered(phi, filters, s.sample_time) : phi);
+    }
+    const std::vector<double> fy = any_filter ? filtered(s.y, filters, s.sample_time)
+                                              : std::vector<double>(s.y.begin(), s.y.end());
+    std::vector<double> target(n);
+    for (std::size_t k = 0; k < n; ++k)
+      target[k] = s.recorded[k] - fy[k];
+    Solved solved = solve(target, cols, fit_rows);
+    if (solved.sse < best.sse) {
+      best = std::move(solved);
+      best_filters = filters;
+      return true;
+    }
+    return false;
+  };
+  for (const ChannelCorrection& filters : filter_grid(s, terms, start)) {
+    try {
+      evaluate(filters);
+    } catch (const std::invalid_argument&) {
+      // a grid point the sample time cannot run (a delay or resonance too large): skipped
+    }
+  }
+  refine(s, terms, start, best_filters, evaluate);
+  CorrectionFit fit;
+  fit.correction = best_filters;
+  fit.correction.temperature_reference_degc = s.temperature_reference_degc;
+  apply_coefficients(terms, columns, best.coefficients, fit.correction);
+  if (1.0 + fit.correction.gain <= 0.0) fit.correction.gain = 0.0;  // keep it invertible
+  fit.output = apply_correction(s, fit.correction);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!fit_rows[k]) continue;
+    const double e = s.recorded[k] - fit.output[k];
+    fit.fit_sse += e * e;
+  }
+  return fit;
+}
+
+}  // namespace selfsense::identification

@@ -1,0 +1,269 @@
+#include "selfsense/models/channel_correction.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace selfsense::models {
+namespace {
+
+bool fail(std::string* why, const std::string& message) {
+  if (why != nullptr) *why = message;
+  return false;
+}
+
+}  // namespace
+
+bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) const {
+  const std::pair<const char*, double> scalars[] = {
+      {"gain", gain},
+      {"offset", offset},
+      {"temperature_reference_degc", temperature_reference_degc},
+      {"temperature_gain_per_k", temperature_gain_per_k},
+      {"temperature_offset_per_k", temperature_offset_per_k},
+      {"temperature_drive_per_k", temperature_drive_per_k},
+      {"stress_gain_per_pa", stress_gain_per_pa},
+      {"drive_quadratic", drive_quadratic},
+      {"drive_cubic", drive_cubic},
+      {"sensed_quadratic", sensed_quadratic},
+      {"dynamics_frequency_hz", dynamics_frequency_hz},
+      {"dynamics_damping", dynamics_damping},
+      {"leakage_tau_s", leakage_tau_s},
+      {"delay_s", delay_s}};
+  for (const auto& [key, value] : scalars) {
+    if (!std::isfinite(value)) return fail(why, prefix + "." + key + ": must be finite");
+  }
+  if (creep_weights.size() != creep_eigenvalues.size()) {
+    return fail(why, prefix + ".creep_weights: needs one weight per eigenvalue");
+  }
+  if (creep_eigenvalues.size() > kMaxCorrectionCreep) {
+    return fail(why, prefix + ".creep_eigenvalues: at most " + std::to_string(kMaxCorrectionCreep) +
+                         " terms");
+  }
+  for (std::size_t i = 0; i < creep_eigenvalues.size(); ++i) {
+    if (!(std::isfinite(creep_eigenvalues[i]) && creep_eigenvalues[i] > 0.0)) {
+      return fail(why, prefix + ".creep_eigenvalues[" + std::to_string(i) + "]: must be > 0");
+    }
+    if (!std::isfinite(creep_weights[i])) {
+      return fail(why, prefix + ".creep_weights[" + std::to_string(i) + "]: must be finite");
+    }
+  }
+  if (dynamics_frequency_hz < 0.0) {
+    return fail(why, prefix + ".dynamics_frequency_hz: must be >= 0 (0: none)");
+  }
+  if (dynamics_frequency_hz > 0.0 && !(dynamics_damping > 0.0)) {
+    return fail(why, prefix + ".dynamics_damping: must be > 0 with a dynamics frequency");
+  }
+  if (leakage_tau_s < 0.0) return fail(why, prefix + ".leakage_tau_s: must be >= 0 (0: none)");
+  if (delay_s < 0.0) return fail(why, prefix + ".delay_s: must be >= 0");
+  if (1.0 + gain <= 0.0) return fail(why, prefix + ".gain: 1 + gain must be > 0");
+  return true;
+}
+
+bool ChannelCorrection::invertible(const std::string& prefix, std::string* why) const {
+  if (stress_gain_per_pa != 0.0) {
+    return fail(why, prefix +
+                         ".stress_gain_per_pa: the sensed channel then depends on T "
+                         "nonlinearly; reconstruction has no closed-form inverse");
+  }
+  if (!creep_weights.empty()) {
+    return fail(why, prefix +
+                         ".creep_weights: creep of the sensed output is not invertible in "
+                         "closed form; identify a hysteresis-creep model instead");
+  }
+  if (dynamics_frequency_hz != 0.0) {
+    return fail(why, prefix +
+                         ".dynamics_frequency_hz: dynamics on the sensed channel are not "
+                         "inverted by the reconstruction");
+  }
+  if (sensed_quadratic != 0.0) {
+    return fail(why, prefix + ".sensed_quadratic: only the strain channel may use it");
+  }
+  return true;
+}
+
+bool ChannelCorrection::empty() const noexcept {
+  return gain == 0.0 && offset == 0.0 && temperature_gain_per_k == 0.0 &&
+         temperature_offset_per_k == 0.0 && temperature_drive_per_k == 0.0 &&
+         stress_gain_per_pa == 0.0 && drive_quadratic == 0.0 && drive_cubic == 0.0 &&
+         sensed_quadratic == 0.0 && creep_weights.empty() && dynamics_frequency_hz == 0.0 &&
+         leakage_tau_s == 0.0 && delay_s == 0.0;
+}
+
+CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sample_time)
+    : c_(correction) {
+  std::string why;
+  if (!c_.is_valid("correction", &why)) throw std::invalid_argument(why);
+  if (!(sample_time > 0.0)) throw std::invalid_argument("correction: sample time must be > 0");
+  creep_count_ = c_.creep_eigenvalues.size();
+  for (std::size_t j = 0; j < creep_count_; ++j) {
+    alpha_[j] = -std::expm1(-c_.creep_eigenvalues[j] * sample_time);
+  }
+  if (c_.dynamics_frequency_hz > 0.0) {
+    const double w0 = 2.0 * std::numbers::pi * c_.dynamics_frequency_hz;
+    if (w0 * sample_time / 2.0 >= 0.95 * std::numbers::pi / 2.0) {
+      throw std::invalid_argument(
+          "correction.dynamics_frequency_hz: at or above Nyquist for this sample time");
+    }
+    const double k = w0 / std::tan(w0 * sample_time / 2.0);
+    const double z = c_.dynamics_damping;
+    const double a0 = k * k + 2.0 * z * w0 * k + w0 * w0;
+    a1_ = (2.0 * w0 * w0 - 2.0 * k * k) / a0;
+    a2_ = (k * k - 2.0 * z * w0 * k + w0 * w0) / a0;
+    b0_ = w0 * w0 / a0;
+    b1_ = 2.0 * b0_;
+    b2_ = b0_;
+    dynamics_ = true;
+  }
+  if (c_.leakage_tau_s > 0.0) {
+    const double r = sample_time / c_.leakage_tau_s;
+    leak_g_ = std::exp(-r);
+    leak_c_ = -std::expm1(-r) / r;
+    leakage_ = true;
+  }
+  if (c_.delay_s > 0.0) {
+    const double samples = c_.delay_s / sample_time;
+    if (samples > static_cast<double>(kMaxCorrectionDelaySamples)) {
+      throw std::invalid_argument("correction.delay_s: more than " +
+                                  std::to_string(kMaxCorrectionDelaySamples) +
+                                  " samples at this sample time");
+    }
+    delay_whole_ = static_cast<std::size_t>(std::floor(samples));
+    delay_frac_ = samples - static_cast<double>(delay_whole_);
+    delay_ = true;
+  }
+}
+
+double CorrectionStage::terms(const Inputs& in) const noexcept {
+  const double dtheta = in.temperature - c_.temperature_reference_degc;
+  const double x = in.drive;
+  return c_.offset + (c_.temperature_offset_per_k + c_.temperature_drive_per_k * x) * dtheta +
+         c_.drive_quadratic * x * x + c_.drive_cubic * x * x * x +
+         c_.sensed_quadratic * in.sensed * in.sensed;
+}
+
+double CorrectionStage::delayed(double value) noexcept {
+  head_ = (head_ + 1) % kLine;
+  line_[head_] = value;
+  if (!delay_) return value;
+  const double a = line_[(head_ + kLine - delay_whole_) % kLine];
+  const double b = line_[(head_ + kLine - delay_whole_ - 1) % kLine];
+  return a + delay_frac_ * (b - a);
+}
+
+double CorrectionStage::filters(double v) noexcept {
+  double w = v;
+  if (dynamics_) {
+    w = b0_ * v + b1_ * v1_ + b2_ * v2_ - a1_ * w1_ - a2_ * w2_;
+    v2_ = v1_;
+    v1_ = v;
+    w2_ = w1_;
+    w1_ = w;
+  }
+  if (leakage_) {
+    m_ = leak_g_ * m_ + leak_c_ * (w - w_prev_);
+    w_prev_ = w;
+    w = m_;
+  }
+  return delayed(w);
+}
+
+double CorrectionStage::step(const Inputs& in) noexcept {
+  const double dtheta = in.temperature - c_.temperature_reference_degc;
+  const bool first = !started_;
+  if (first) {
+    started_ = true;
+    y0_ = in.response;
+    for (std::size_t j = 0; j < creep_count_; ++j)
+      z_[j] = in.response;
+  }
+  double v = in.y * (1.0 + c_.gain + c_.temperature_gain_per_k * dtheta) +
+             c_.stress_gain_per_pa * in.stress * in.response + terms(in);
+  for (std::size_t j = 0; j < creep_count_; ++j) {
+    z_[j] += alpha_[j] * (in.response - z_[j]);
+    v += c_.creep_weights[j] * (z_[j] - y0_);
+  }
+  if (first) {  // the filters start in steady state at the first value
+    v1_ = v2_ = w1_ = w2_ = v;
+    m_ = w_prev_ = v;
+    line_.fill(v);
+  }
+  return filters(v);
+}
+
+double CorrectionStage::delay_drive(double drive) noexcept {
+  if (!drive_started_) {
+    drive_started_ = true;
+    drive_line_.fill(drive);
+  }
+  drive_head_ = (drive_head_ + 1) % kLine;
+  drive_line_[drive_head_] = drive;
+  if (!delay_) return drive;
+  const double a = drive_line_[(drive_head_ + kLine - delay_whole_) % kLine];
+  const double b = drive_line_[(drive_head_ + kLine - delay_whole_ - 1) % kLine];
+  return a + delay_frac_ * (b - a);
+}
+
+double CorrectionStage::invert(double measured, const Inputs& in) noexcept {
+  double w = measured;
+  if (leakage_) {
+    if (!started_) {
+      m_ = measured;
+      w_prev_ = measured;
+    }
+    w = w_prev_ + (measured - leak_g_ * m_) / leak_c_;
+    m_ = measured;
+    w_prev_ = w;
+  }
+  started_ = true;
+  const double dtheta = in.temperature - c_.temperature_reference_degc;
+  return (w - terms(in)) / (1.0 + c_.gain + c_.temperature_gain_per_k * dtheta);
+}
+
+void CorrectionStage::save_state(std::span<double> out) const noexcept {
+  std::size_t i = 0;
+  const double head[12] = {started_ ? 1.0 : 0.0,
+                           y0_,
+                           v1_,
+                           v2_,
+                           w1_,
+                           w2_,
+                           m_,
+                           w_prev_,
+                           static_cast<double>(head_),
+                           static_cast<double>(drive_head_),
+                           drive_started_ ? 1.0 : 0.0,
+                           0.0};
+  for (const double v : head)
+    out[i++] = v;
+  for (const double v : z_)
+    out[i++] = v;
+  for (const double v : line_)
+    out[i++] = v;
+  for (const double v : drive_line_)
+    out[i++] = v;
+}
+
+void CorrectionStage::restore_state(std::span<const double> in) noexcept {
+  std::size_t i = 0;
+  started_ = in[i++] != 0.0;
+  y0_ = in[i++];
+  v1_ = in[i++];
+  v2_ = in[i++];
+  w1_ = in[i++];
+  w2_ = in[i++];
+  m_ = in[i++];
+  w_prev_ = in[i++];
+  head_ = static_cast<std::size_t>(in[i++]) % kLine;
+  drive_head_ = static_cast<std::size_t>(in[i++]) % kLine;
+  drive_started_ = in[i++] != 0.0;
+  ++i;
+  for (double& v : z_)
+    v = in[i++];
+  for (double& v : line_)
+    v = in[i++];
+  for (double& v : drive_line_)
+    v = in[i++];
+}
+
+}  // namespace selfsense::models

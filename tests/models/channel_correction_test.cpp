@@ -1,0 +1,185 @@
+// Corrections a diagnosis adds (models/channel_correction.hpp) as the runtime runs them:
+// forward in the simulation, inverted in the reconstruction, saved and restored, written to and
+// read from model files, refused by name where no inverse exists.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "selfsense/model_io/model_yaml.hpp"
+#include "selfsense/models/runtime_model.hpp"
+#include "support/allocation_counter.hpp"
+#include "support/transducer_data.hpp"
+
+namespace selfsense::models {
+namespace {
+
+constexpr double kTs = 1e-4;
+
+ChannelCorrection sensed_correction() {
+  ChannelCorrection c;
+  c.gain = 0.02;
+  c.offset = 1.5e-3;
+  c.temperature_reference_degc = 25.0;
+  c.temperature_gain_per_k = 1e-3;
+  c.temperature_offset_per_k = 2e-5;
+  c.temperature_drive_per_k = 1e-11;
+  c.drive_quadratic = 1e-15;
+  c.drive_cubic = -2e-22;
+  c.leakage_tau_s = 0.5;
+  c.delay_s = 3.5 * kTs;
+  return c;
+}
+
+ChannelCorrection strain_correction() {
+  ChannelCorrection c;
+  c.gain = -0.01;
+  c.stress_gain_per_pa = 3e-9;
+  c.sensed_quadratic = 2e-3;
+  c.creep_eigenvalues = {100.0, 10.0, 1.0};
+  c.creep_weights = {0.01, 0.012, 0.015};
+  c.dynamics_frequency_hz = 800.0;
+  c.dynamics_damping = 0.1;
+  return c;
+}
+
+TransducerModel corrected_model() {
+  TransducerModel m = test::typical_transducer(kTs);
+  m.sensed_correction = sensed_correction();
+  m.strain_correction = strain_correction();
+  return m;
+}
+
+// The reconstruction undoes what the simulation added on the sensed channel: from the
+// simulated D (leakage, delay, gain, offset, temperature, polynomial) it recovers the stress
+// that drove the simulation, a delay later.
+TEST(ChannelCorrection, ReconstructionInvertsTheSensedCorrection) {
+  TransducerModel m = corrected_model();
+  m.strain_correction.reset();
+  const test::TransducerData data = test::transducer_data(m, 4000, kTs, 3);
+  Simulation sim(m);
+  Reconstruction rec(m);
+  sim.set_temperature(31.0);
+  rec.set_temperature(31.0);
+  double worst = 0.0;
+  double range = 0.0;
+  std::vector<double> t_hat;
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    const Simulation::Output out = sim.step(data.e[k], data.t[k]);
+    t_hat.push_back(rec.step(data.e[k], out.sensed).stress);
+    range = std::max(range, std::abs(data.t[k]));
+  }
+  // D is 3.5 samples late; the reconstruction delays E to match, so T_hat[k] is T at k - 3.5.
+  for (std::size_t k = 100; k < data.e.size(); ++k) {
+    const double truth = 0.5 * (data.t[k - 3] + data.t[k - 4]);
+    worst = std::max(worst, std::abs(t_hat[k] - truth));
+  }
+  EXPECT_LT(worst, 0.02 * range);
+}
+
+TEST(ChannelCorrection, ForwardCorrectionChangesTheOutputAsWritten) {
+  TransducerModel base = test::typical_transducer(kTs);
+  TransducerModel with_offset = base;
+  ChannelCorrection c;
+  c.gain = 0.1;
+  c.offset = 2e-3;
+  with_offset.sensed_correction = c;
+  Simulation a(base);
+  Simulation b(with_offset);
+  for (int k = 0; k < 200; ++k) {
+    const double e = 1e6 + 5e5 * std::sin(0.05 * k);
+    const double y = a.step(e, -1e6).sensed;
+    EXPECT_NEAR(b.step(e, -1e6).sensed, 1.1 * y + 2e-3, 1e-12);
+  }
+}
+
+TEST(ChannelCorrection, StateSavedAndRestoredContinuesBitIdentically) {
+  const TransducerModel m = corrected_model();
+  const test::TransducerData data = test::transducer_data(m, 1000, kTs, 4);
+  Simulation sim(m);
+  SavedState state = sim.make_saved_state();
+  for (std::size_t k = 0; k < 500; ++k)
+    static_cast<void>(sim.step(data.e[k], data.t[k]));
+  ASSERT_TRUE(sim.save_state(state));
+  std::vector<double> first;
+  for (std::size_t k = 500; k < 1000; ++k)
+    first.push_back(sim.step(data.e[k], data.t[k]).strain);
+  ASSERT_EQ(sim.restore_state(state), RestoreResult::kOk);
+  for (std::size_t k = 500; k < 1000; ++k) {
+    EXPECT_EQ(sim.step(data.e[k], data.t[k]).strain, first[k - 500]) << k;
+  }
+  // A model without the corrections is another model.
+  Simulation plain(test::typical_transducer(kTs));
+  EXPECT_EQ(plain.restore_state(state), RestoreResult::kWrongModel);
+}
+
+TEST(ChannelCorrection, ModelFileRoundTripKeepsEveryTermAndTheIdentity) {
+  const TransducerModel m = corrected_model();
+  const TransducerModel back = model_from_string(model_to_string(m));
+  ASSERT_TRUE(back.sensed_correction && back.strain_correction);
+  EXPECT_EQ(back.sensed_correction->delay_s, m.sensed_correction->delay_s);
+  EXPECT_EQ(back.sensed_correction->temperature_drive_per_k,
+            m.sensed_correction->temperature_drive_per_k);
+  EXPECT_EQ(back.strain_correction->creep_weights, m.strain_correction->creep_weights);
+  EXPECT_EQ(parameter_hash(back), parameter_hash(m));
+  EXPECT_NE(parameter_hash(back), parameter_hash(test::typical_transducer(kTs)));
+}
+
+TEST(ChannelCorrection, BadValuesAreNamedByKey) {
+  TransducerModel m = test::typical_transducer(kTs);
+  m.strain_correction = strain_correction();
+  m.strain_correction->creep_weights.pop_back();
+  std::string why;
+  EXPECT_FALSE(m.is_valid(&why));
+  EXPECT_NE(why.find("corrections.strain.creep_weights"), std::string::npos) << why;
+  const std::string text = model_to_string(corrected_model());
+  const std::string bad = text.substr(0, text.find("leakage_tau_s")) + "leakage_tau_s: -1" +
+                          text.substr(text.find('\n', text.find("leakage_tau_s")));
+  try {
+    static_cast<void>(model_from_string(bad, "m.yaml"));
+    FAIL() << "a negative leakage time constant was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("corrections.sensed.leakage_tau_s"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ChannelCorrection, ReconstructionRefusesASensedCorrectionWithoutInverse) {
+  TransducerModel m = test::typical_transducer(kTs);
+  ChannelCorrection c;
+  c.creep_eigenvalues = {1.0};
+  c.creep_weights = {0.01};
+  m.sensed_correction = c;
+  try {
+    Reconstruction rec(m);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("corrections.sensed.creep_weights"), std::string::npos);
+  }
+  EXPECT_NO_THROW(Simulation sim(m));
+}
+
+TEST(ChannelCorrection, StepsDoNotAllocate) {
+  TransducerModel m = corrected_model();
+  const test::TransducerData data = test::transducer_data(m, 2000, kTs, 5);
+  m.strain_correction->sensed_quadratic = 0.0;
+  Simulation sim(m);
+  Reconstruction rec(m);
+  SavedState state = sim.make_saved_state();
+  double sink = 0.0;
+  test::AllocationCounter counter;
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    sim.set_temperature(25.0 + 1e-3 * static_cast<double>(k));
+    const Simulation::Output out = sim.step(data.e[k], data.t[k]);
+    sink += rec.step(data.e[k], out.sensed).strain;
+    static_cast<void>(sim.save_state(state));
+    static_cast<void>(sim.restore_state(state));
+  }
+  EXPECT_EQ(counter.count(), 0U);
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+}  // namespace
+}  // namespace selfsense::models
