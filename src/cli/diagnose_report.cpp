@@ -19,6 +19,7 @@ constexpr std::string_view kRecordedColour = "#222222";
 constexpr std::string_view kBeforeColour = "#d95f02";
 constexpr std::string_view kAfterColour = "#1f77b4";
 constexpr std::string_view kBoundColour = "#c00000";
+constexpr std::string_view kBoundLabel = "\u00B1bound (99 %)";  // UTF-8, as the page says
 constexpr std::size_t kMaxSegmentsListed = 12;
 
 constexpr std::string_view kStyle = R"(
@@ -305,14 +306,21 @@ std::string correlation_plot(const ReportCorrelation& c, bool cross, std::string
   for (std::size_t i = 0; i < values.size(); ++i) {
     lags[i] = static_cast<double>(i) - (cross ? half : 0.0);
   }
-  const std::string title = cross ? channel + " residual x " + drive + ", " + std::string(which)
-                                  : channel + " residual autocorrelation, " + std::string(which);
+  const std::string title =
+      cross ? channel + " residual \xC3\x97 " + drive + ", " + std::string(which)
+            : channel + " residual autocorrelation, " + std::string(which);
   SvgPlot plot(title, "lag [samples]", cross ? "cross-correlation" : "autocorrelation");
   plot.add_stems(std::string(which), lags, values, std::string(colour));
   const double bound = std::abs(c.bound);
   if (bound > 0.0) {
-    plot.add_reference("+-bound (99 %)", bound, std::string(kBoundColour));
-    plot.add_reference("+-bound (99 %)", -bound, std::string(kBoundColour));
+    plot.add_reference(
+        "\xC2\xB1"
+        "bound (99 %)",
+        bound, std::string(kBoundColour));
+    plot.add_reference(
+        "\xC2\xB1"
+        "bound (99 %)",
+        -bound, std::string(kBoundColour));
   }
   std::string caption;
   if (!values.empty()) {

@@ -5,9 +5,11 @@
 #include <charconv>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <system_error>
+#include <unordered_set>
 #include <utility>
 
 namespace selfsense::cli {
@@ -122,34 +124,52 @@ Reduced reduce_columns(std::span<const double> x, std::span<const double> y, std
   return out;
 }
 
-// A path in x and y: a point each time the pen enters another cell of a grid of cell x cell
-// pixels; the grid coarsens until the budget holds.
+// A path in x and y (a loop traced many times): each step of the pen from one cell of a grid
+// of cell x cell pixels to another is drawn once; steps already drawn are skipped (the pen
+// lifts). The grid coarsens until the budget holds, so no segment is longer than a few cells
+// unless the data jump.
 Reduced reduce_path(std::span<const double> x, std::span<const double> y, std::size_t columns,
                     std::size_t rows) {
   const Range rx = range_of(x);
   const Range ry = range_of(y);
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
   for (std::size_t cell = 1;; cell *= 2) {
     const std::size_t nx = std::max<std::size_t>(1, columns / cell);
     const std::size_t ny = std::max<std::size_t>(1, rows / cell);
+    const bool last_try = nx == 1 && ny == 1;
     Reduced out;
-    std::size_t last = std::numeric_limits<std::size_t>::max();
-    std::size_t last_index = 0;
+    std::unordered_set<std::uint64_t> drawn;
+    std::size_t last = kNone;
+    std::size_t last_index = 0;     // the sample where the pen entered the cell `last`
+    std::size_t pen_index = kNone;  // the sample the output ends on
     for (std::size_t i = 0; i < x.size(); ++i) {
       if (!std::isfinite(x[i]) || !std::isfinite(y[i])) {
-        out.gap();
-        last = std::numeric_limits<std::size_t>::max();
+        last = kNone;
         continue;
       }
       const std::size_t c = cell_of(x[i], rx, nx) * ny + cell_of(y[i], ry, ny);
-      last_index = i;
       if (c == last) continue;
-      out.push(x[i], y[i]);
+      if (last != kNone) {
+        const std::size_t lo = std::min(c, last);
+        const std::size_t hi = std::max(c, last);
+        if (drawn.insert((static_cast<std::uint64_t>(lo) << 32U) | hi).second) {
+          if (pen_index != last_index) {
+            out.gap();
+            out.push(x[last_index], y[last_index]);
+          }
+          out.push(x[i], y[i]);
+          pen_index = i;
+        }
+      } else {
+        out.gap();
+        out.push(x[i], y[i]);  // a dot where a piece starts
+        pen_index = i;
+      }
       last = c;
+      last_index = i;
+      if (out.x.size() > kLoopBudget && !last_try) break;
     }
-    if (!x.empty() && std::isfinite(x[last_index]) && std::isfinite(y[last_index])) {
-      out.push(x[last_index], y[last_index]);  // the end of the path
-    }
-    if (out.x.size() <= kLoopBudget || (nx == 1 && ny == 1)) return out;
+    if (out.x.size() <= kLoopBudget || last_try) return out;
   }
 }
 

@@ -25,14 +25,14 @@ class SvgPlot {
           int height = kDefaultHeight);
 
   // y against x joined in order. Reduced to the samples with the smallest and largest y per
-  // pixel column when x increases (a time series), otherwise to the samples that move the pen
-  // to another cell of a grid coarse enough for the point budget (a loop).
+  // pixel column when x increases (a time series), otherwise to the steps of the pen between
+  // cells of a grid coarse enough for the point budget, each step drawn once (a loop).
   void add_line(std::string label, std::span<const double> x, std::span<const double> y,
                 std::string colour);
   // Points; reduced to one point per occupied cell of a grid coarse enough for the budget.
   void add_scatter(std::string label, std::span<const double> x, std::span<const double> y,
                    std::string colour);
-  // Vertical stems from 0 to y at each x, with a dot at the top.
+  // Vertical stems from 0 to y at each x.
   void add_stems(std::string label, std::span<const double> x, std::span<const double> y,
                  std::string colour);
   // A dashed horizontal line across the plot (e.g. a confidence bound); in the legend once.
