@@ -206,8 +206,10 @@ std::vector<double> ticks(const Range& r) {
     step = m * power;
   }
   const double first = std::ceil(r.lo / step);
-  for (double k = first; k * step <= r.hi + 1e-9 * step; k += 1.0) {
+  // At most a dozen; k + 1 == k far from zero (a range small against its offset) ends it too.
+  for (double k = first; k * step <= r.hi + 1e-9 * step && out.size() < 12; k += 1.0) {
     const double v = k * step;
+    if (!out.empty() && v <= out.back()) break;
     out.push_back(std::abs(v) < 1e-12 * step ? 0.0 : v);
   }
   return out;
@@ -215,6 +217,8 @@ std::vector<double> ticks(const Range& r) {
 
 // A pixel coordinate: one decimal, no exponent.
 void append_coordinate(std::string& out, double v) {
+  // Ranges near the limits of double can make a coordinate overflow; never print nan or inf.
+  v = std::isfinite(v) ? std::clamp(v, -1.0e6, 1.0e6) : 0.0;
   std::array<char, 32> buf{};
   const auto [end, ec] =
       std::to_chars(buf.data(), buf.data() + buf.size(), v, std::chars_format::fixed, 1);

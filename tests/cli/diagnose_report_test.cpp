@@ -224,6 +224,17 @@ TEST(SvgPlot, LoopsAndScattersHaveABudget) {
   EXPECT_GE(scatter.point_count(), 500U);
 }
 
+TEST(SvgPlot, ExtremeRangesNeitherHangNorPrintNaN) {
+  const std::vector<double> offset_x = {1.7e18, 1.7e18 + 1024.0, 1.7e18 + 4096.0};
+  const std::vector<double> huge_y = {-1.0e308, 0.0, 1.0e308};
+  SvgPlot plot("extreme", "x", "y");
+  plot.add_line("a", offset_x, huge_y, "#000");
+  plot.add_scatter("b", huge_y, huge_y, "#000");
+  const std::string svg = plot.render();
+  EXPECT_FALSE(has_non_finite_text(svg));
+  EXPECT_EQ(count(svg, "<svg"), count(svg, "</svg>"));
+}
+
 TEST(SvgPlot, EmptyPlotSaysNoData) {
   SvgPlot plot("empty", "x", "y");
   plot.add_line("nothing", {}, {}, "#000");
