@@ -68,23 +68,27 @@ std::string segment_list(const std::vector<ReportSegment>& where) {
 
 // The time axis for n samples: t when it covers them, else the sample index.
 struct TimeAxis {
-  std::vector<double> index;  // only filled when t is too short
-  std::span<const double> values;
+  std::span<const double> t;  // empty when t is too short
+  std::vector<double> index;  // the sample index then
   std::string label;
+
+  [[nodiscard]] bool in_seconds() const { return !t.empty(); }
+  [[nodiscard]] std::span<const double> first(std::size_t n) const {
+    return (in_seconds() ? t : std::span<const double>(index)).first(n);
+  }
 };
 
 TimeAxis time_axis(const ReportInput& input, std::size_t n) {
   TimeAxis axis;
-  if (input.t.size() >= n) {
-    axis.values = std::span<const double>(input.t).first(n);
+  if (n > 0 && input.t.size() >= n) {
+    axis.t = std::span<const double>(input.t).first(n);
     axis.label = "t [s]";
     return axis;
   }
   axis.index.resize(n);
   for (std::size_t i = 0; i < n; ++i)
     axis.index[i] = static_cast<double>(i);
-  axis.values = axis.index;
-  axis.label = "sample";
+  axis.label = "sample (no time column for all samples)";
   return axis;
 }
 
@@ -222,10 +226,12 @@ std::string residual_section(const ReportInput& in) {
     const TimeAxis axis = time_axis(in, std::max(before.size(), after.size()));
     SvgPlot plot(ch.name + ": residual (recorded - model)", axis.label,
                  with_unit(ch.name + " residual", ch.unit), 900, 300);
-    for (const ReportSegment& s : ch.located)
-      plot.add_band(s.t_start, s.t_end);
-    plot.add_line("before", axis.values.first(before.size()), before, std::string(kBeforeColour));
-    plot.add_line("after", axis.values.first(after.size()), after, std::string(kAfterColour));
+    if (axis.in_seconds()) {
+      for (const ReportSegment& s : ch.located)
+        plot.add_band(s.t_start, s.t_end);
+    }
+    plot.add_line("before", axis.first(before.size()), before, std::string(kBeforeColour));
+    plot.add_line("after", axis.first(after.size()), after, std::string(kAfterColour));
     std::string caption = std::to_string(ch.located.size()) + " located segment" +
                           (ch.located.size() == 1 ? "" : "s");
     if (!ch.located.empty()) caption += ": " + segment_list(ch.located);

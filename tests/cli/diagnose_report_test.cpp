@@ -176,6 +176,16 @@ TEST_F(DiagnoseReport, ChannelWithoutDataAndNoFindings) {
   EXPECT_FALSE(has_non_finite_text(html));
 }
 
+TEST_F(DiagnoseReport, WithoutTimeDrawsAgainstTheSampleIndex) {
+  ReportInput in = test::make_sample_report(1000);
+  in.t.clear();
+  const std::string html = write(in);
+  EXPECT_NE(html.find("sample (no time column for all samples)"), std::string::npos);
+  EXPECT_EQ(html.find("#f5c242"), std::string::npos);          // segments in s cannot be shaded
+  EXPECT_NE(html.find("0.1&ndash;0.2 s"), std::string::npos);  // still listed
+  EXPECT_TRUE(svgs_balanced(html));
+}
+
 TEST_F(DiagnoseReport, UnwritablePathThrowsNamingIt) {
   const fs::path path = dir_ / "missing" / "report.html";
   try {
