@@ -368,7 +368,10 @@ std::string SvgPlot::render() const {
     ry.include(r.y);
   for (const double v : extra_y_)
     ry.include(v);
-  const Range xr = widened(rx, 0.0);
+  // Stems at the ends of the range would sit on the frame: a little room for them.
+  const bool stems = std::any_of(series_.begin(), series_.end(),
+                                 [](const Series& s) { return s.kind == Kind::kStems; });
+  const Range xr = widened(rx, stems ? 0.02 : 0.0);
   const Range yr = widened(ry, 0.05);
 
   const double left = kMarginLeft;
