@@ -22,6 +22,7 @@ packages=(
   nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
+  zlib1g-dev chromium fonts-liberation  # the diagnosis report's browser test (tests/cli)
 )
 
 install_missing() {
