@@ -20,7 +20,7 @@ struct ReportSegment {
 struct ReportCorrelation {
   std::string channel{};
   int max_lag{25};
-  std::vector<double> autocorrelation{};  // max_lag + 1 values, lag 0 first (1.0)
+  std::vector<double> autocorrelation{};    // max_lag + 1 values, lag 0 first (1.0)
   std::vector<double> cross_correlation{};  // 2 max_lag + 1 values, lag -max_lag first
   double bound{0.0};
 };
@@ -48,8 +48,8 @@ struct ReportChannel {
   std::string name{};  // "S" or "D"
   std::string unit{};  // "-" or "C/m^2"
   std::vector<double> recorded{};
-  std::vector<double> before{};  // model output before
-  std::vector<double> after{};   // model output after
+  std::vector<double> before{};          // model output before
+  std::vector<double> after{};           // model output after
   std::vector<ReportSegment> located{};  // where the residual is large or structured
   ReportCorrelation test_before{};
   ReportCorrelation test_after{};

@@ -51,6 +51,10 @@ FieldSignals field_signals(const io::Recording& rec, const std::string& source,
   out.d = channel(rec, source, geometry, "D", "q", &models::Geometry::displacement_density);
   out.s = channel(rec, source, geometry, "S", "x", &models::Geometry::strain);
   out.stress = channel(rec, source, geometry, "T", "F", &models::Geometry::stress);
+  if (rec.has("temp")) {
+    const auto temp = rec.column("temp");
+    out.temp.assign(temp.begin(), temp.end());
+  }
   const char* needed = drive == models::Drive::kField ? "E (or u)" : "D (or q)";
   if (out.drive(drive).empty()) {
     throw io::RecordingError(source + ": missing the drive column " + needed);

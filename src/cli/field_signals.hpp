@@ -20,6 +20,7 @@ struct FieldSignals {
   std::vector<double> d{};       // [C/m^2]
   std::vector<double> s{};       // [-]
   std::vector<double> stress{};  // [Pa]
+  std::vector<double> temp{};    // [degC]; empty if absent
   double sample_time{0.0};       // mean step of t [s]
 
   [[nodiscard]] std::size_t size() const noexcept { return t.size(); }

@@ -47,6 +47,11 @@ const std::vector<Candidate>& candidates() {
        false,
        true,
        Needs::kStress},
+      {"stress_dependence",
+       {CorrectionTerm::kStressQuadratic, CorrectionTerm::kOffset},
+       true,
+       false,
+       Needs::kStress},
       {"permittivity_nonlinearity",
        {CorrectionTerm::kDrivePolynomial},
        true,
@@ -236,10 +241,21 @@ void describe(Finding& f, const ChannelCorrection& c, const ChannelData& ch, con
     f.feature_name = "temperature [degC]";
     f.feature.assign(s.temperature.begin(), s.temperature.end());
   } else if (f.effect == "stress_dependence") {
-    f.evidence = "the coupling of " + n +
-                 format(" changes with stress by %.3g %% per MPa over %.3g MPa",
-                        100.0 * c.stress_gain_per_pa * 1e6, range_of(s.stress) * 1e-6) +
-                 tail;
+    if (c.stress_quadratic_per_pa2 != 0.0) {
+      const double t = std::max(std::abs(*std::max_element(s.stress.begin(), s.stress.end())),
+                                std::abs(*std::min_element(s.stress.begin(), s.stress.end())));
+      f.evidence = "the recorded " + n +
+                   format(
+                       " bends with the square of the stress (the coupling changes with "
+                       "stress; %.3g %% of range at %.3g MPa)",
+                       std::abs(c.stress_quadratic_per_pa2) * t * t * pct, t * 1e-6) +
+                   tail;
+    } else {
+      f.evidence = "the coupling of " + n +
+                   format(" changes with stress by %.3g %% per MPa over %.3g MPa",
+                          100.0 * c.stress_gain_per_pa * 1e6, range_of(s.stress) * 1e-6) +
+                   tail;
+    }
     f.feature_name = "stress T [Pa]";
     f.feature.assign(s.stress.begin(), s.stress.end());
   } else if (f.effect == "permittivity_nonlinearity") {
@@ -281,6 +297,18 @@ bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, boo
       return true;
   }
   return true;
+}
+
+// The candidate brings a filter whose parameters are not chosen yet.
+bool searches_filter(const Candidate& c, const ChannelCorrection& accepted) {
+  for (const CorrectionTerm t : c.terms) {
+    if ((t == CorrectionTerm::kLeakage && accepted.leakage_tau_s == 0.0) ||
+        (t == CorrectionTerm::kDelay && accepted.delay_s == 0.0) ||
+        (t == CorrectionTerm::kDynamics && accepted.dynamics_frequency_hz == 0.0)) {
+      return true;
+    }
+  }
+  return false;
 }
 
 // Coefficients and searched parameters a term adds: the parsimony tie-break.
@@ -405,8 +433,24 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         if (std::find(used.begin(), used.end(), &c) != used.end()) continue;
         if (!applicable(c, ch, s, has_sensor)) continue;
         const std::vector<CorrectionTerm> terms = merged(accepted_terms, c.terms);
+        ChannelCorrection start = accepted;
+        if (searches_filter(c, accepted) && !accepted_terms.empty()) {
+          // Search the new filter's parameters on what the accepted terms leave (few columns),
+          // then refit every coefficient jointly with the filters fixed.
+          identification::CorrectionSignals on_current = cs;
+          on_current.y = current;
+          const ChannelCorrection found =
+              identification::fit_correction(on_current, c.terms, ChannelCorrection{}, fit_rows)
+                  .correction;
+          start.leakage_tau_s = std::max(start.leakage_tau_s, found.leakage_tau_s);
+          start.delay_s = std::max(start.delay_s, found.delay_s);
+          if (start.dynamics_frequency_hz == 0.0) {
+            start.dynamics_frequency_hz = found.dynamics_frequency_hz;
+            start.dynamics_damping = found.dynamics_damping;
+          }
+        }
         identification::CorrectionFit fit =
-            identification::fit_correction(cs, terms, accepted, fit_rows);
+            identification::fit_correction(cs, terms, start, fit_rows);
         const double sse = held_out_sse(ch.recorded, fit.output, fit_rows);
         const double typical =
             median_block_explains(ch.recorded, current, fit.output, fit_rows, blocks);

@@ -60,6 +60,12 @@ Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm>
       case CorrectionTerm::kStress:
         add([&](std::size_t k) { return at(s.stress, k, 0.0) * at(s.response, k, s.y[k]); });
         break;
+      case CorrectionTerm::kStressQuadratic:
+        add([&](std::size_t k) {
+          const double stress = at(s.stress, k, 0.0);
+          return stress * stress;
+        });
+        break;
       case CorrectionTerm::kDrivePolynomial:
         add([&](std::size_t k) { return s.drive[k] * s.drive[k]; });
         add([&](std::size_t k) { return s.drive[k] * s.drive[k] * s.drive[k]; });
@@ -119,6 +125,9 @@ void apply_coefficients(std::span<const CorrectionTerm> terms, const Columns& co
         break;
       case CorrectionTerm::kStress:
         out.stress_gain_per_pa = c[i++];
+        break;
+      case CorrectionTerm::kStressQuadratic:
+        out.stress_quadratic_per_pa2 = c[i++];
         break;
       case CorrectionTerm::kDrivePolynomial:
         out.drive_quadratic = c[i++];

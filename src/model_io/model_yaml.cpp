@@ -116,7 +116,7 @@ std::optional<InputRange> read_range(YamlMap& map, std::string_view key) {
 // The scalar keys of a correction (channel_correction.hpp), shared by reading and writing.
 template <typename C>
 auto correction_scalars(C& c) {
-  return std::array<std::pair<const char*, decltype(&c.gain)>, 14>{{
+  return std::array<std::pair<const char*, decltype(&c.gain)>, 15>{{
       {"gain", &c.gain},
       {"offset", &c.offset},
       {"temperature_reference_degc", &c.temperature_reference_degc},
@@ -124,6 +124,7 @@ auto correction_scalars(C& c) {
       {"temperature_offset_per_k", &c.temperature_offset_per_k},
       {"temperature_drive_per_k", &c.temperature_drive_per_k},
       {"stress_gain_per_pa", &c.stress_gain_per_pa},
+      {"stress_quadratic_per_pa2", &c.stress_quadratic_per_pa2},
       {"drive_quadratic", &c.drive_quadratic},
       {"drive_cubic", &c.drive_cubic},
       {"sensed_quadratic", &c.sensed_quadratic},
@@ -253,8 +254,13 @@ void emit_vectorial(YAML::Emitter& out, const StressHysteresisModel& m) {
 
 void emit_correction(YAML::Emitter& out, const char* key, const ChannelCorrection& c) {
   out << YAML::Key << key << YAML::Value << YAML::BeginMap;
-  for (const auto& [name, field] : correction_scalars(c)) {
-    out << YAML::Key << name << YAML::Value << *field;
+  // Terms a diagnosis did not add stay at their defaults and are left out.
+  const ChannelCorrection defaults;
+  const auto fallback = correction_scalars(defaults);
+  const auto fields = correction_scalars(c);
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    if (*fields[i].second == *fallback[i].second) continue;
+    out << YAML::Key << fields[i].first << YAML::Value << *fields[i].second;
   }
   if (!c.creep_eigenvalues.empty()) {
     emit_sequence(out, "creep_eigenvalues", c.creep_eigenvalues);

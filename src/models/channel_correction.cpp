@@ -23,6 +23,7 @@ bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) co
       {"temperature_offset_per_k", temperature_offset_per_k},
       {"temperature_drive_per_k", temperature_drive_per_k},
       {"stress_gain_per_pa", stress_gain_per_pa},
+      {"stress_quadratic_per_pa2", stress_quadratic_per_pa2},
       {"drive_quadratic", drive_quadratic},
       {"drive_cubic", drive_cubic},
       {"sensed_quadratic", sensed_quadratic},
@@ -85,9 +86,9 @@ bool ChannelCorrection::invertible(const std::string& prefix, std::string* why) 
 bool ChannelCorrection::empty() const noexcept {
   return gain == 0.0 && offset == 0.0 && temperature_gain_per_k == 0.0 &&
          temperature_offset_per_k == 0.0 && temperature_drive_per_k == 0.0 &&
-         stress_gain_per_pa == 0.0 && drive_quadratic == 0.0 && drive_cubic == 0.0 &&
-         sensed_quadratic == 0.0 && creep_weights.empty() && dynamics_frequency_hz == 0.0 &&
-         leakage_tau_s == 0.0 && delay_s == 0.0;
+         stress_gain_per_pa == 0.0 && stress_quadratic_per_pa2 == 0.0 && drive_quadratic == 0.0 &&
+         drive_cubic == 0.0 && sensed_quadratic == 0.0 && creep_weights.empty() &&
+         dynamics_frequency_hz == 0.0 && leakage_tau_s == 0.0 && delay_s == 0.0;
 }
 
 CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sample_time)
@@ -178,7 +179,8 @@ double CorrectionStage::step(const Inputs& in) noexcept {
       z_[j] = in.response;
   }
   double v = in.y * (1.0 + c_.gain + c_.temperature_gain_per_k * dtheta) +
-             c_.stress_gain_per_pa * in.stress * in.response + terms(in);
+             c_.stress_gain_per_pa * in.stress * in.response +
+             c_.stress_quadratic_per_pa2 * in.stress * in.stress + terms(in);
   for (std::size_t j = 0; j < creep_count_; ++j) {
     z_[j] += alpha_[j] * (in.response - z_[j]);
     v += c_.creep_weights[j] * (z_[j] - y0_);
@@ -218,6 +220,18 @@ double CorrectionStage::invert(double measured, const Inputs& in) noexcept {
   started_ = true;
   const double dtheta = in.temperature - c_.temperature_reference_degc;
   return (w - terms(in)) / (1.0 + c_.gain + c_.temperature_gain_per_k * dtheta);
+}
+
+double CorrectionStage::solve_stress(double t_lin, double coupling,
+                                     const Inputs& in) const noexcept {
+  if (c_.stress_quadratic_per_pa2 == 0.0 || coupling == 0.0) return t_lin;
+  const double dtheta = in.temperature - c_.temperature_reference_degc;
+  const double q =
+      c_.stress_quadratic_per_pa2 / (1.0 + c_.gain + c_.temperature_gain_per_k * dtheta);
+  // q T^2 + d T - d T_lin = 0, the root that tends to T_lin as q -> 0 (no cancellation).
+  const double disc = coupling * coupling + 4.0 * q * coupling * t_lin;
+  if (!(disc >= 0.0)) return -coupling / (2.0 * q);  // past the vertex: the nearest stress
+  return 2.0 * coupling * t_lin / (coupling + std::copysign(std::sqrt(disc), coupling));
 }
 
 void CorrectionStage::save_state(std::span<double> out) const noexcept {

@@ -56,8 +56,8 @@ void add_correction(Fnv1a& h, const std::optional<ChannelCorrection>& c) noexcep
   for (const double x :
        {c->gain, c->offset, c->temperature_reference_degc, c->temperature_gain_per_k,
         c->temperature_offset_per_k, c->temperature_drive_per_k, c->stress_gain_per_pa,
-        c->drive_quadratic, c->drive_cubic, c->sensed_quadratic, c->dynamics_frequency_hz,
-        c->dynamics_damping, c->leakage_tau_s, c->delay_s}) {
+        c->stress_quadratic_per_pa2, c->drive_quadratic, c->drive_cubic, c->sensed_quadratic,
+        c->dynamics_frequency_hz, c->dynamics_damping, c->leakage_tau_s, c->delay_s}) {
     h.add(x);
   }
   h.add(c->creep_eigenvalues);

@@ -284,6 +284,12 @@ Reconstruction::Estimate Reconstruction::kernel_step(double drive, double sensed
     const StressHysteresisReconstructor::Estimate e = std::get<Vectorial>(impl_)->step(x, y);
     out = {e.stress, e.strain, e.status};
   }
+  if (sensed_fix_ && sensed_coupling_ != 0.0) {
+    const double stress = sensed_fix_->solve_stress(out.stress, sensed_coupling_,
+                                                    {0.0, x, 0.0, temperature_, 0.0, 0.0});
+    out.strain += strain_coupling_ * (stress - out.stress);
+    out.stress = stress;
+  }
   if (strain_fix_) {
     out.strain = strain_fix_->step(
         {out.strain, x, out.stress, temperature_, y, out.strain - strain_coupling_ * out.stress});

@@ -275,7 +275,9 @@ INSTANTIATE_TEST_SUITE_P(
                x.temperature.end_degc = 45.0;
              },
              {{"temperature_dependence", "D"}}},
-        Case{"stress_dependence", stress_coupling, {{"stress_dependence", "S"}}},
+        Case{"stress_dependence",
+             stress_coupling,
+             {{"stress_dependence", "S"}, {"stress_dependence", "D"}}},
         Case{"permittivity_nonlinearity", permittivity, {{"permittivity_nonlinearity", "D"}}},
         Case{"leakage_and_creep",
              [](plant::PlantConfig& p, plant::ExcitationConfig& x) {
@@ -294,7 +296,7 @@ INSTANTIATE_TEST_SUITE_P(
                stress_coupling(p, x);
                leakage(p, x);
              },
-             {{"stress_dependence", "S"}, {"charge_leakage", "D"}}}),
+             {{"stress_dependence", "S"}, {"stress_dependence", "D"}, {"charge_leakage", "D"}}}),
     [](const ::testing::TestParamInfo<Case>& param) { return param.param.name; });
 
 }  // namespace

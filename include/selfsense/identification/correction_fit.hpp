@@ -20,9 +20,10 @@
 namespace selfsense::identification {
 
 enum class CorrectionTerm : std::uint8_t {
-  kOffset,       // gain and offset
-  kTemperature,  // gain and offset per kelvin
-  kStress,       // gain per pascal
+  kOffset,           // gain and offset
+  kTemperature,      // gain and offset per kelvin
+  kStress,           // gain per pascal (of the drive response)
+  kStressQuadratic,  // T^2: a stress-dependent coupling seen on the sensed channel
   kDrivePolynomial,
   kSensedQuadratic,
   kCreep,     // log-spaced lags of y

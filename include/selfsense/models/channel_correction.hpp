@@ -5,7 +5,7 @@
 //         + temperature_gain (theta - theta_ref) y
 //         + temperature_offset (theta - theta_ref)               temperature_dependence
 //         + temperature_drive (theta - theta_ref) x
-//         + stress_gain T r                                      stress_dependence
+//         + stress_gain T r + stress_quadratic T^2               stress_dependence
 //         + drive_quadratic x^2 + drive_cubic x^3                permittivity_nonlinearity
 //         + sensed_quadratic s^2                                 electrostriction (S ~ P^2, P ~ D)
 //         + sum_j creep_weights_j (z_j - r_0)                    creep (eq. 28: K = L[H])
@@ -17,14 +17,17 @@
 //   out[k] = m(k Ts - delay)  (linear interpolation, delay <= 64 samples)        delay
 // x: the drive (E for field drive), T: stress [Pa], theta: temperature [degC], s: the model's
 // sensed output (D), r = y - coupling T the channel's response to the drive alone (so a coupling
-// that changes with stress, d(T) = d (1 + k T), is k T r). Units: gain, temperature_gain [1/K],
-// stress_gain [1/Pa] relative; offset and the polynomial terms in the channel's unit.
+// that changes with stress, d(T) = d (1 + k T), is k T r on S and d k T^2 on D). Units: gain,
+// temperature_gain [1/K], stress_gain [1/Pa] relative; offset and the polynomial terms in the
+// channel's unit.
 //
 // Reconstruction needs the inverse on the sensed channel: the leakage is undone
 // (w[k] = w[k-1] + (m[k] - g m[k-1]) / c), a delay moves to the drive, and the additive and
-// gain terms that do not depend on T are solved for y. Terms that depend on T or on y's history
-// (stress_gain, creep, dynamics) make the sensor side non-invertible in closed form:
-// invertible() says so and the Reconstruction refuses such a model by name.
+// gain terms that do not depend on T are solved for y; stress_quadratic is solved with the
+// sensor coupling d after the kernel: d T + q' T^2 = d T_lin (q' = q / (1 + gain terms)). Terms
+// that depend on T or on y's history (stress_gain, creep, dynamics) make the sensor side
+// non-invertible in closed form: invertible() says so and the Reconstruction refuses such a model
+// by name.
 //
 // Real-time safe after construction: step(), invert(), save/restore are noexcept and allocate
 // nothing.
@@ -46,6 +49,7 @@ struct ChannelCorrection {
   double temperature_offset_per_k{0.0};
   double temperature_drive_per_k{0.0};
   double stress_gain_per_pa{0.0};
+  double stress_quadratic_per_pa2{0.0};
   double drive_quadratic{0.0};
   double drive_cubic{0.0};
   double sensed_quadratic{0.0};
@@ -88,6 +92,9 @@ class CorrectionStage {
   // explains the measurement `measured` at this sample; `in.y` is ignored and the drive must
   // already be delayed by the caller (delay_samples()).
   double invert(double measured, const Inputs& in) noexcept;
+  // After the kernel: the stress that solves the stress_quadratic term, from the kernel's
+  // T_lin and the sensor coupling d (T_lin itself without the term).
+  [[nodiscard]] double solve_stress(double t_lin, double coupling, const Inputs& in) const noexcept;
   // The drive delayed by this channel's delay (reconstruction feeds it to the kernel).
   double delay_drive(double drive) noexcept;
 
