@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace selfsense::drivers::can {
@@ -67,9 +68,11 @@ bool is_valid(const FrameId& f, std::string* why) {
   const std::uint32_t max = f.extended ? kExtendedIdMax : kStandardIdMax;
   if (f.id > max) {
     if (why != nullptr) {
-      *why = std::to_string(f.id) + " does not fit a " +
-             (f.extended ? std::string("29-bit extended") : std::string("11-bit standard")) +
-             " identifier (max " + std::to_string(max) + ")";
+      std::array<char, 96> buf{};
+      const int n = std::snprintf(buf.data(), buf.size(),
+                                  "0x%X does not fit a %s identifier (max 0x%X)", f.id,
+                                  f.extended ? "29-bit extended" : "11-bit standard", max);
+      *why = std::string(buf.data(), n > 0 ? static_cast<std::size_t>(n) : 0U);
     }
     return false;
   }

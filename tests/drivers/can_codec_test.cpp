@@ -229,7 +229,7 @@ TEST(CanCodec, ValidationNamesTheProblem) {
   EXPECT_FALSE(is_valid(sig(0, 8, ByteOrder::kLittle, false, 0.0), 8, &why));
   EXPECT_EQ(why, "scale must be finite and != 0");
   EXPECT_FALSE(is_valid(FrameId{0x800, false}, &why));
-  EXPECT_EQ(why, "2048 does not fit a 11-bit standard identifier (max 2047)");
+  EXPECT_EQ(why, "0x800 does not fit a 11-bit standard identifier (max 0x7FF)");
   EXPECT_TRUE(is_valid(FrameId{0x800, true}, &why));
   EXPECT_FALSE(is_valid(FrameId{0x20000000, true}, &why));
 }
