@@ -69,9 +69,9 @@ bool is_valid(const FrameId& f, std::string* why) {
   if (f.id > max) {
     if (why != nullptr) {
       std::array<char, 96> buf{};
-      const int n = std::snprintf(buf.data(), buf.size(),
-                                  "0x%X does not fit a %s identifier (max 0x%X)", f.id,
-                                  f.extended ? "29-bit extended" : "11-bit standard", max);
+      const int n =
+          std::snprintf(buf.data(), buf.size(), "0x%X does not fit a %s identifier (max 0x%X)",
+                        f.id, f.extended ? "29-bit extended" : "11-bit standard", max);
       *why = std::string(buf.data(), n > 0 ? static_cast<std::size_t>(n) : 0U);
     }
     return false;
@@ -110,6 +110,7 @@ void insert_raw(std::span<std::uint8_t> data, const Signal& s, std::uint64_t raw
 }
 
 double decode(std::span<const std::uint8_t> data, const Signal& s) noexcept {
+  if (s.length < 1 || s.length > 64) return 0.0;  // not a valid layout (is_valid() says so)
   const std::uint64_t raw = extract_raw(data, s);
   double value = 0.0;
   if (s.is_signed) {
@@ -124,6 +125,7 @@ double decode(std::span<const std::uint8_t> data, const Signal& s) noexcept {
 
 EncodeResult encode(std::span<std::uint8_t> data, const Signal& s, double value) noexcept {
   if (!std::isfinite(value)) return EncodeResult::kNotFinite;
+  if (s.length < 1 || s.length > 64) return EncodeResult::kNotFinite;  // not a valid layout
   const double q = std::nearbyint((value - s.offset) / s.scale);
   if (!std::isfinite(q)) return EncodeResult::kNotFinite;
   EncodeResult result = EncodeResult::kOk;

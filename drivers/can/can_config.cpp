@@ -154,12 +154,13 @@ void read_can_config(io::YamlMap& driver, double loop_rate_hz, CanConfig& out,
     auto& owners = it->second;
     const char* other = nullptr;
     std::uint32_t at = 0;
-    for_each_bit(s->signal, [&](std::uint32_t p) {
+    const char* const self = name;
+    for_each_bit(s->signal, [&owners, &other, &at, self](std::uint32_t p) {
       if (owners.at(p) != nullptr && other == nullptr) {
         other = owners.at(p);
         at = p;
       }
-      owners.at(p) = name;
+      owners.at(p) = self;
     });
     if (other != nullptr) {
       problem(std::string("signals.") + name, std::string("overlaps signal ") + other +

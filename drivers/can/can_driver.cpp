@@ -92,7 +92,8 @@ bool CanDriver::activate(std::string* why) {
                 " (a kernel without SocketCAN? modprobe can can_raw)");
   }
   ifreq ifr{};
-  std::snprintf(ifr.ifr_name, sizeof(ifr.ifr_name), "%s", config_.interface.c_str());
+  static_cast<void>(
+      std::snprintf(ifr.ifr_name, sizeof(ifr.ifr_name), "%s", config_.interface.c_str()));
   if (::ioctl(socket_, SIOCGIFINDEX, &ifr) < 0) {
     return fail("driver.interface: " + config_.interface + ": " + std::strerror(errno));
   }
@@ -283,6 +284,25 @@ void CanDriver::deactivate() noexcept {
   ::close(socket_);
   socket_ = -1;
   active_ = false;
+  // Not real-time here: the loop has stopped. One line for the log (and the measured figures).
+  const runtime::DriverCounters c = counters();
+  static_cast<void>(std::fprintf(
+      stderr,
+      "can: %s: rx_to_tx_us p50=%.0f p99=%.0f max=%.0f read_to_write_us p50=%.1f p99=%.1f "
+      "max=%.1f (n=%lld); reads=%llu writes=%llu errors=%llu timeouts=%llu stale=%llu "
+      "bad_data=%llu retries=%llu reconnects=%llu device_faults=%llu\n",
+      config_.interface.c_str(), static_cast<double>(rx_to_tx_.percentile_ns(0.5)) / 1e3,
+      static_cast<double>(rx_to_tx_.percentile_ns(0.99)) / 1e3,
+      static_cast<double>(rx_to_tx_.max_ns()) / 1e3,
+      static_cast<double>(read_to_write_.percentile_ns(0.5)) / 1e3,
+      static_cast<double>(read_to_write_.percentile_ns(0.99)) / 1e3,
+      static_cast<double>(read_to_write_.max_ns()) / 1e3,
+      static_cast<long long>(read_to_write_.count()), static_cast<unsigned long long>(c.reads),
+      static_cast<unsigned long long>(c.writes), static_cast<unsigned long long>(c.errors),
+      static_cast<unsigned long long>(c.timeouts), static_cast<unsigned long long>(c.stale),
+      static_cast<unsigned long long>(c.bad_data), static_cast<unsigned long long>(c.retries),
+      static_cast<unsigned long long>(c.reconnects),
+      static_cast<unsigned long long>(c.device_faults)));
 }
 
 runtime::DriverCounters CanDriver::counters() const noexcept {

@@ -134,7 +134,8 @@ int run_can_sim_device(const CanSimDeviceOptions& options) {
                 " (a kernel without SocketCAN? modprobe can can_raw)");
   }
   ifreq ifr{};
-  std::snprintf(ifr.ifr_name, sizeof(ifr.ifr_name), "%s", layout.interface.c_str());
+  static_cast<void>(
+      std::snprintf(ifr.ifr_name, sizeof(ifr.ifr_name), "%s", layout.interface.c_str()));
   if (::ioctl(sock.fd, SIOCGIFINDEX, &ifr) < 0) {
     return fail("--can " + layout.interface + ": " + std::strerror(errno));
   }
