@@ -225,6 +225,7 @@ runtime::DriverStatus CanDriver::read(runtime::InputSample& out) noexcept {
   out.device_status = static_cast<std::uint16_t>(
       (bus_off ? kStatusBusOff : 0U) |
       (error_passive_.load(std::memory_order_relaxed) ? kStatusErrorPassive : 0U));
+  read_ok_ = false;
   if (bus_off) {
     bump(n_.disconnected);
     return runtime::DriverStatus::kDisconnected;
@@ -244,6 +245,7 @@ runtime::DriverStatus CanDriver::read(runtime::InputSample& out) noexcept {
     bump(n_.stale);
     return runtime::DriverStatus::kStale;
   }
+  read_ok_ = true;
   return runtime::DriverStatus::kOk;
 }
 
@@ -259,7 +261,7 @@ runtime::DriverStatus CanDriver::write(const runtime::OutputCommand& command) no
   const std::int64_t now = now_ns();
   if (n == static_cast<ssize_t>(tx_size_)) {
     bump(n_.writes);
-    if (last_.newest_ns != 0) rx_to_tx_.record(now - last_.newest_ns);
+    if (read_ok_) rx_to_tx_.record(now - last_.newest_ns);
     read_to_write_.record(now - read_ns_);
     return runtime::DriverStatus::kOk;
   }

@@ -79,7 +79,8 @@ class CanDriver final : public runtime::Driver {
   [[nodiscard]] CanCounters can_counters() const noexcept;
 
   // Latencies recorded by write() (real-time thread only; read them after deactivate()):
-  // from the newest input frame's arrival to the command's send, and from read() to write().
+  // from the arrival of the newest input frame to the send of the command computed from it
+  // (cycles whose read() returned kOk), and from read() to write().
   [[nodiscard]] const runtime::LatencyHistogram& rx_to_tx() const noexcept { return rx_to_tx_; }
   [[nodiscard]] const runtime::LatencyHistogram& read_to_write() const noexcept {
     return read_to_write_;
@@ -115,6 +116,7 @@ class CanDriver final : public runtime::Driver {
   std::uint32_t repeats_{0};
   std::int64_t activated_ns_{0};
   std::int64_t read_ns_{0};
+  bool read_ok_{false};  // the last read() returned kOk (its inputs make the command)
   canfd_frame tx_{};
   std::size_t tx_size_{CAN_MTU};
   runtime::LatencyHistogram rx_to_tx_{};

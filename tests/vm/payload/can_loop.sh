@@ -55,7 +55,7 @@ wait_socket() {
   fail "the daemon's control socket did not come up"
 }
 
-candump -e -L vcanl0 >"$work/candump.log" &
+candump -L vcanl0,0:0,#FFFFFFFF >"$work/candump.log" &
 pids+=($!)
 dump=$!
 sleep 0.5
@@ -171,3 +171,28 @@ fd_inputs=$(grep -c ' vcanl1 101##' "$work/candump-fd.log" || true)
 fd_commands=$(grep -c ' vcanl1 18FF0001##' "$work/candump-fd.log" || true)
 echo "fd_frames=$([ "$fd_inputs" -gt 100 ] && [ "$fd_commands" -gt 100 ] && echo yes || echo no) (101: $fd_inputs, 18FF0001: $fd_commands)"
 sed -n 's/^can: vcanl1: /fd_driver: /p' "$work/daemon-fd.log"
+
+# Measured only (not asserted): the loop rate the VM sustains over vcan, node and daemon both at
+# the rate, 3 s each, disarmed (read and write every cycle all the same).
+for r in 250 1000 2000; do
+  sweep_cfg=$work/config/can-sweep-$r.yaml
+  sed -e "s/rate_hz: 500 /rate_hz: $r /" -e "s|can-sim/|can-sweep-$r/|" "$cfg" >"$sweep_cfg"
+  sock=$work/build/can-sweep-$r/control.sock
+  selfsense sim-device --can vcanl0 --config "$sweep_cfg" --plant "$plant" --rate "$r" \
+    --duration 5 >"$work/sim-sweep.log" 2>&1 &
+  sim=$!
+  selfsensed --config "$sweep_cfg" >"$work/daemon-sweep.log" 2>&1 &
+  daemon=$!
+  wait_socket
+  sleep 1
+  t1=$(date +%s.%N)
+  c1=$(field cycles "$(ctl status)")
+  sleep 2
+  t2=$(date +%s.%N)
+  status=$(ctl status)
+  c2=$(field cycles "$status")
+  kill -TERM "$daemon"
+  wait "$daemon" || true
+  wait "$sim" || true
+  echo "sweep_rate=$r achieved_hz=$(awk -v a="$c1" -v b="$c2" -v s="$t1" -v e="$t2" 'BEGIN { printf "%.0f", (b - a) / (e - s) }') overruns=$(field overruns "$status") missed=$(field missed_periods "$status") timeouts=$(field driver_timeouts "$status") $(sed -n 's/^sim-device: stopped: \(ticks=[0-9]* late=[0-9]*\).*/node_\1/p' "$work/sim-sweep.log") $(sed -n 's/^can: vcanl0: \(rx_to_tx_us p50=[0-9]*\).*\(read_to_write_us p50=[0-9.]*\).*/\1 \2/p' "$work/daemon-sweep.log")"
+done
