@@ -169,7 +169,11 @@ void CanDriver::on_frame(const canfd_frame& frame, std::int64_t now) noexcept {
   bump(n_.rx_frames);
   if ((frame.can_id & CAN_ERR_FLAG) != 0U) {
     bump(n_.error_frames);
-    if ((frame.can_id & CAN_ERR_BUSOFF) != 0U && !bus_off_.exchange(true)) bump(n_.bus_off);
+    if ((frame.can_id & CAN_ERR_BUSOFF) != 0U && !bus_off_.load(std::memory_order_relaxed)) {
+      bus_off_seen_.store(false, std::memory_order_relaxed);
+      bus_off_.store(true, std::memory_order_relaxed);
+      bump(n_.bus_off);
+    }
     if ((frame.can_id & CAN_ERR_RESTARTED) != 0U && bus_off_.exchange(false)) bump(n_.reconnects);
     if ((frame.can_id & CAN_ERR_CRTL) != 0U && frame.len > 1) {
       const std::uint8_t ctrl = frame.data[1];
@@ -204,7 +208,11 @@ void CanDriver::on_frame(const canfd_frame& frame, std::int64_t now) noexcept {
   ++building_.sequence;
   building_.newest_ns = now;
   building_.sample.timestamp_ns = now;
-  if (bus_off_.exchange(false)) bump(n_.reconnects);  // a frame came in: the bus works again
+  // An input frame after the loop has seen the bus-off: the bus works again.
+  if (bus_off_.load(std::memory_order_relaxed) && bus_off_seen_.load(std::memory_order_relaxed)) {
+    bus_off_.store(false, std::memory_order_relaxed);
+    bump(n_.reconnects);
+  }
   latest_.publish(building_);
 }
 
@@ -227,6 +235,7 @@ runtime::DriverStatus CanDriver::read(runtime::InputSample& out) noexcept {
       (error_passive_.load(std::memory_order_relaxed) ? kStatusErrorPassive : 0U));
   read_ok_ = false;
   if (bus_off) {
+    bus_off_seen_.store(true, std::memory_order_relaxed);
     bump(n_.disconnected);
     return runtime::DriverStatus::kDisconnected;
   }

@@ -15,8 +15,9 @@
 // anyway and add that thread's scheduling delay.
 //
 // Statuses of read(): kTimeout when E or D is older than rx_timeout_ms (or never arrived),
-// kDisconnected while the controller is bus-off, kStale after stale_cycles reads in a row
-// without a new input frame (0: off), kOk otherwise.
+// kDisconnected while the controller is bus-off (from a CAN_ERR_BUSOFF error frame until
+// CAN_ERR_RESTARTED, or until an input frame arrives after read() has reported the bus-off), kStale
+// after stale_cycles reads in a row without a new input frame (0: off), kOk otherwise.
 //
 // Counters (DriverCounters): reads, writes (commands sent), errors (error frames received and
 // failed sends), timeouts, stale (reads that returned those), bad_data (input frames shorter
@@ -130,6 +131,7 @@ class CanDriver final : public runtime::Driver {
   };
   Atomics n_{};
   std::atomic<bool> bus_off_{false};
+  std::atomic<bool> bus_off_seen_{false};  // a read() has returned kDisconnected for it
   std::atomic<bool> error_passive_{false};
 };
 

@@ -14,6 +14,10 @@ vm_check_test "${1:?usage: tests/vm/can_loop.sh OUT_DIR}" can_loop \
   'bad_data_counted=yes .*' \
   'error_frame_counted=yes .*' \
   'state_after_injection="armed"' \
+  'bus_off_counted=yes' \
+  'bus_off_recovered=yes' \
+  'state_after_bus_off="faulted"' \
+  'state_rearmed="armed"' \
   'sim_device_exit=0' \
   'sim_device_summary=yes' \
   'timeouts_counted=yes .*' \
@@ -22,7 +26,7 @@ vm_check_test "${1:?usage: tests/vm/can_loop.sh OUT_DIR}" can_loop \
   'command_after_kill=0(\.0)?' \
   'daemon_exit=0' \
   'candump_frames=yes .*' \
-  'candump_injected=2' \
+  'candump_injected=3' \
   'last_command=18FF0001#00000000' \
   'fd_inputs_decoded=yes .*' \
   'fd_frames=yes .*'

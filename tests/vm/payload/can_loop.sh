@@ -91,7 +91,6 @@ echo "s_hat=$(field S_hat "$status") s_true=$(field S "$status") setpoint=$(fiel
 echo "overruns=$(field overruns "$status") cycles=$(field cycles "$status")"
 before_bad=$(field driver_bad_data "$status")
 before_err=$(field driver_errors "$status")
-before_timeouts=$(field driver_timeouts "$status")
 
 # A frame of the inputs' ID too short for its signals, and a controller error frame.
 cansend vcanl0 101#01
@@ -103,6 +102,21 @@ after_err=$(field driver_errors "$status")
 echo "bad_data_counted=$([ "$after_bad" -gt "$before_bad" ] && echo yes || echo no) ($before_bad -> $after_bad)"
 echo "error_frame_counted=$([ "$after_err" -gt "$before_err" ] && echo yes || echo no) ($before_err -> $after_err)"
 echo "state_after_injection=$(field state "$status")"
+
+# Bus-off (an error frame with CAN_ERR_BUSOFF): counted, reads disconnected until the next input
+# frame shows the bus works again (counted as a reconnect); the loop faults and is re-armed.
+cansend vcanl0 20000040#0000000000000000 || fail "cansend could not send a bus-off frame"
+sleep 0.5
+status=$(ctl status)
+echo "bus_off_counted=$([ "$(field driver_device_faults "$status")" -ge 1 ] && echo yes || echo no)"
+echo "bus_off_recovered=$([ "$(field driver_reconnects "$status")" -ge 1 ] && echo yes || echo no)"
+echo "state_after_bus_off=$(field state "$status")"
+ctl reset >/dev/null || fail "ctl reset after bus-off"
+ctl arm >/dev/null || fail "ctl arm after bus-off"
+sleep 0.5
+status=$(ctl status)
+echo "state_rearmed=$(field state "$status")"
+before_timeouts=$(field driver_timeouts "$status")
 
 # The node dies: no inputs, timeout fault, safe output.
 kill -TERM "$sim"
@@ -129,7 +143,7 @@ inputs=$(grep -c ' vcanl0 101#' "$work/candump.log" || true)
 refs=$(grep -c ' vcanl0 102#' "$work/candump.log" || true)
 commands=$(grep -c ' vcanl0 18FF0001#' "$work/candump.log" || true)
 echo "candump_frames=$([ "$inputs" -gt 100 ] && [ "$refs" -gt 100 ] && [ "$commands" -gt 100 ] && echo yes || echo no) (101: $inputs, 102: $refs, 18FF0001: $commands)"
-echo "candump_injected=$(grep -cE ' vcanl0 (101#01|20000004#0004000000000000)$' "$work/candump.log")"
+echo "candump_injected=$(grep -cE ' vcanl0 (101#01|20000004#0004000000000000|20000040#0000000000000000)$' "$work/candump.log")"
 # The last command on the bus is the safe output, E = 0.
 echo "last_command=$(grep ' vcanl0 18FF0001#' "$work/candump.log" | tail -1 | awk '{ print $3 }')"
 
