@@ -28,5 +28,6 @@ vm_check_test "${1:?usage: tests/vm/can_loop.sh OUT_DIR}" can_loop \
   'candump_frames=yes .*' \
   'candump_injected=3' \
   'last_command=18FF0001#00000000' \
+  'realtime_allocations=0 locks=0 reads_ok=[0-9]+ writes_ok=2000 cycles=2000' \
   'fd_inputs_decoded=yes .*' \
   'fd_frames=yes .*'

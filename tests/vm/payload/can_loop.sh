@@ -68,6 +68,7 @@ daemon=$!
 pids+=("$daemon")
 wait_socket
 sleep 1
+ctl mode position >/dev/null || fail "ctl mode position"
 ctl reset >/dev/null || fail "ctl reset"
 ctl arm >/dev/null || fail "ctl arm: $(ctl status)"
 target=5.0e-4
@@ -146,6 +147,18 @@ echo "candump_frames=$([ "$inputs" -gt 100 ] && [ "$refs" -gt 100 ] && [ "$comma
 echo "candump_injected=$(grep -cE ' vcanl0 (101#01|20000004#0004000000000000|20000040#0000000000000000)$' "$work/candump.log")"
 # The last command on the bus is the safe output, E = 0.
 echo "last_command=$(grep ' vcanl0 18FF0001#' "$work/candump.log" | tail -1 | awk '{ print $3 }')"
+
+# The driver's real-time calls alone (tests/drivers/can_driver_realtime.cpp): 2 s of read() and
+# write() at 1 kHz against the node, with every allocation and lock in the process counted.
+selfsense sim-device --can vcanl0 --config "$cfg" --plant "$plant" --rate "$rate" \
+  --duration 8 >"$work/sim-rt.log" 2>&1 &
+sim=$!
+pids+=("$sim")
+sleep 0.5
+rt=$(can_driver_realtime vcanl0 "$cfg" 2>&1) || true
+echo "$rt"
+kill -TERM "$sim" 2>/dev/null || true
+wait "$sim" || true
 
 # CAN FD on vcanl1 (MTU 72): the same layout in FD frames.
 fd_cfg=$work/config/can-fd.yaml
