@@ -9,16 +9,14 @@ namespace selfsense::drivers::can {
 namespace {
 
 bool bit_at(std::span<const std::uint8_t> data, std::uint32_t p) noexcept {
-  return ((data[p / 8U] >> (p % 8U)) & 1U) != 0U;
+  const unsigned byte = data[p / 8U];
+  return ((byte >> (p % 8U)) & 1U) != 0U;
 }
 
 void set_bit(std::span<std::uint8_t> data, std::uint32_t p, bool on) noexcept {
-  const auto mask = static_cast<std::uint8_t>(1U << (p % 8U));
-  if (on) {
-    data[p / 8U] = static_cast<std::uint8_t>(data[p / 8U] | mask);
-  } else {
-    data[p / 8U] = static_cast<std::uint8_t>(data[p / 8U] & ~mask);
-  }
+  const unsigned mask = 1U << (p % 8U);
+  const unsigned byte = data[p / 8U];
+  data[p / 8U] = static_cast<std::uint8_t>(on ? (byte | mask) : (byte & ~mask));
 }
 
 std::uint64_t low_mask(std::uint32_t length) noexcept {
