@@ -4,19 +4,23 @@
 //
 //   type: simulated     the simulated transducer (drivers/sim)
 //     plant: PATH       a plant configuration (config/plant/), relative to the daemon's file
+//   type: can           SocketCAN (drivers/can, docs/drivers/can.md)
+//     interface, fd, rx_timeout_ms, stale_cycles, error_frames, signals: {e, d, s_ref, t_ref,
+//     command}          see drivers/can/can_config.hpp
 #pragma once
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "can/can_config.hpp"
 #include "selfsense/daemon/config.hpp"
 #include "selfsense/plant/config.hpp"
 #include "selfsense/runtime/driver.hpp"
 
 namespace selfsense::drivers {
 
-// Every driver type, for messages: "simulated".
+// Every driver type, for messages: "simulated, can".
 [[nodiscard]] std::string driver_types();
 
 class Registry final : public daemon::DriverSectionReader {
@@ -25,11 +29,14 @@ class Registry final : public daemon::DriverSectionReader {
             std::vector<std::string>& problems) override;
   // The driver read last; throws std::logic_error if read() found problems or was not called.
   [[nodiscard]] std::unique_ptr<runtime::Driver> create() const;
+  // The CAN section read last (driver.type can), for `selfsense sim-device --can`.
+  [[nodiscard]] const can::CanConfig& can_config() const noexcept { return can_; }
 
  private:
   std::string type_{};
   bool ok_{false};
   plant::PlantConfig plant_{};
+  can::CanConfig can_{};
 };
 
 }  // namespace selfsense::drivers

@@ -24,5 +24,6 @@ void add_import_command(CLI::App& app);
 void add_check_config_command(CLI::App& app);
 void add_ctl_command(CLI::App& app);
 void add_diagnose_command(CLI::App& app);
+void add_sim_device_command(CLI::App& app);
 
 }  // namespace selfsense::cli

@@ -1,0 +1,138 @@
+// The SocketCAN driver of the loop (runtime::Driver): the inputs E, D (and S_ref, T_ref) arrive
+// in CAN or CAN FD frames laid out as the configuration's signal definitions say (can_config.hpp,
+// codec in can_codec.hpp); the command E leaves in a frame of its own. docs/drivers/can.md.
+//
+// Threads. activate() opens a raw CAN socket (bound to the interface, filtered to the input
+// frames and, when enabled, error frames) and starts the bus thread: it blocks in poll() with a
+// timeout, decodes every frame, keeps the newest value of each signal and publishes the whole
+// input set, with the receive time of E and D, through a LatestValue (a sequence lock: the bus
+// thread never waits for the loop). read() on the real-time thread takes the newest set without
+// waiting (a bounded number of attempts; if a publish overlapped them all, the set read last
+// time is used again). write() encodes the command and sends it with send(MSG_DONTWAIT) from
+// the real-time thread itself: one system call that never waits (a full TX queue is counted
+// and the next cycle sends the newer command), which puts the command on the bus in the same
+// cycle that read its inputs; handing it to the bus thread would need a wake-up system call
+// anyway and add that thread's scheduling delay.
+//
+// Statuses of read(): kTimeout when E or D is older than rx_timeout_ms (or never arrived),
+// kDisconnected while the controller is bus-off (from a CAN_ERR_BUSOFF error frame until
+// CAN_ERR_RESTARTED, or until an input frame arrives after read() has reported the bus-off), kStale
+// after stale_cycles reads in a row without a new input frame (0: off), kOk otherwise.
+//
+// Counters (DriverCounters): reads, writes (commands sent), errors (error frames received and
+// failed sends), timeouts, stale (reads that returned those), bad_data (input frames shorter
+// than their signals need, dropped), retries (commands not sent on a full TX queue),
+// reconnects (recoveries from bus-off), device_faults (bus-off events).
+#pragma once
+
+#include <linux/can.h>
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <thread>
+
+#include "can/can_config.hpp"
+#include "selfsense/runtime/driver.hpp"
+#include "selfsense/runtime/latency_histogram.hpp"
+#include "selfsense/runtime/latest_value.hpp"
+
+namespace selfsense::drivers::can {
+
+// Bits of InputSample::device_status.
+inline constexpr std::uint16_t kStatusBusOff = 1U << 0U;
+inline constexpr std::uint16_t kStatusErrorPassive = 1U << 1U;
+
+// Beyond DriverCounters, for the documentation's figures and the tests.
+struct CanCounters {
+  std::uint64_t rx_frames{0};          // frames received (data and error)
+  std::uint64_t error_frames{0};       // of which error frames
+  std::uint64_t tx_frames{0};          // command frames sent
+  std::uint64_t command_saturated{0};  // commands outside the signal's raw range (clamped)
+};
+
+// The input set the bus thread publishes to read().
+struct CanInputs {
+  runtime::InputSample sample{};
+  std::uint64_t sequence{0};  // input frames accepted so far
+  std::int64_t e_ns{0};       // arrival of the newest E (0: none yet)
+  std::int64_t d_ns{0};
+  std::int64_t newest_ns{0};  // arrival of the newest input frame
+};
+
+class CanDriver final : public runtime::Driver {
+ public:
+  explicit CanDriver(CanConfig config);
+  ~CanDriver() override;
+  CanDriver(const CanDriver&) = delete;
+  CanDriver& operator=(const CanDriver&) = delete;
+  CanDriver(CanDriver&&) = delete;
+  CanDriver& operator=(CanDriver&&) = delete;
+
+  [[nodiscard]] std::string_view name() const noexcept override { return "can"; }
+  bool configure(const runtime::DriverSetup& setup, std::string* why) override;
+  bool activate(std::string* why) override;
+  runtime::DriverStatus read(runtime::InputSample& out) noexcept override;
+  runtime::DriverStatus write(const runtime::OutputCommand& command) noexcept override;
+  void deactivate() noexcept override;
+  [[nodiscard]] bool has_references() const noexcept override { return config_.has_references(); }
+  [[nodiscard]] runtime::DriverCounters counters() const noexcept override;
+  [[nodiscard]] CanCounters can_counters() const noexcept;
+
+  // Latencies recorded by write() (real-time thread only; read them after deactivate()):
+  // from the arrival of the newest input frame to the send of the command computed from it
+  // (cycles whose read() returned kOk), and from read() to write().
+  [[nodiscard]] const runtime::LatencyHistogram& rx_to_tx() const noexcept { return rx_to_tx_; }
+  [[nodiscard]] const runtime::LatencyHistogram& read_to_write() const noexcept {
+    return read_to_write_;
+  }
+
+ private:
+  // One input signal and where it goes.
+  struct Slot {
+    SignalConfig config{};
+    std::size_t bytes{0};
+    double runtime::InputSample::*field{nullptr};
+  };
+
+  void bus_loop() noexcept;
+  void on_frame(const canfd_frame& frame, std::int64_t now_ns) noexcept;
+
+  CanConfig config_;
+  std::array<Slot, 4> slots_{};
+  std::int64_t rx_timeout_ns_{0};
+  int socket_{-1};
+  bool configured_{false};
+  bool active_{false};
+  std::thread thread_{};
+  std::atomic<bool> stop_{false};
+  runtime::LatestValue<CanInputs> latest_{};
+
+  // Bus thread only.
+  CanInputs building_{};
+
+  // Real-time thread only.
+  CanInputs last_{};
+  std::uint64_t last_sequence_{0};
+  std::uint32_t repeats_{0};
+  std::int64_t activated_ns_{0};
+  std::int64_t read_ns_{0};
+  bool read_ok_{false};  // the last read() returned kOk (its inputs make the command)
+  canfd_frame tx_{};
+  std::size_t tx_size_{CAN_MTU};
+  runtime::LatencyHistogram rx_to_tx_{};
+  runtime::LatencyHistogram read_to_write_{};
+
+  // Each written by one thread, read by any.
+  struct Atomics {
+    std::atomic<std::uint64_t> reads{0}, writes{0}, tx_errors{0}, timeouts{0}, stale{0},
+        bad_data{0}, retries{0}, reconnects{0}, bus_off{0}, rx_frames{0}, error_frames{0},
+        saturated{0}, disconnected{0};
+  };
+  Atomics n_{};
+  std::atomic<bool> bus_off_{false};
+  std::atomic<bool> bus_off_seen_{false};  // a read() has returned kDisconnected for it
+  std::atomic<bool> error_passive_{false};
+};
+
+}  // namespace selfsense::drivers::can
