@@ -3,6 +3,7 @@
 #include <exception>
 #include <stdexcept>
 
+#include "modbus/modbus_driver.hpp"
 #include "selfsense/io/yaml_map.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
 #include "sim/simulated_transducer.hpp"
@@ -43,7 +44,7 @@ void read_simulated(io::YamlMap& driver, const daemon::DaemonConfig& config,
 }  // namespace
 
 std::string driver_types() {
-  return "simulated";
+  return "simulated, modbus-tcp, modbus-rtu";
 }
 
 void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
@@ -52,6 +53,10 @@ void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
   const std::size_t before = problems.size();
   if (type_ == "simulated") {
     read_simulated(driver, config, plant_, problems);
+  } else if (type_ == "modbus-tcp" || type_ == "modbus-rtu") {
+    modbus::read_modbus_section(
+        driver, type_ == "modbus-tcp" ? modbus::Transport::kTcp : modbus::Transport::kRtu, modbus_,
+        problems);
   } else {
     problems.push_back(
         driver.locate("driver.type: '" + type_ + "' is not one of " + driver_types()));
@@ -61,6 +66,9 @@ void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
 
 std::unique_ptr<runtime::Driver> Registry::create() const {
   if (!ok_) throw std::logic_error("driver registry: no valid driver section was read");
+  if (type_ == "modbus-tcp" || type_ == "modbus-rtu") {
+    return std::make_unique<modbus::ModbusDriver>(modbus_);
+  }
   return std::make_unique<SimulatedTransducer>(plant_);
 }
 

@@ -4,19 +4,21 @@
 //
 //   type: simulated     the simulated transducer (drivers/sim)
 //     plant: PATH       a plant configuration (config/plant/), relative to the daemon's file
+//   type: modbus-tcp | modbus-rtu   the Modbus driver (drivers/modbus, docs/drivers/modbus.md)
 #pragma once
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "modbus/modbus_config.hpp"
 #include "selfsense/daemon/config.hpp"
 #include "selfsense/plant/config.hpp"
 #include "selfsense/runtime/driver.hpp"
 
 namespace selfsense::drivers {
 
-// Every driver type, for messages: "simulated".
+// Every driver type, for messages: "simulated, modbus-tcp, modbus-rtu".
 [[nodiscard]] std::string driver_types();
 
 class Registry final : public daemon::DriverSectionReader {
@@ -30,6 +32,7 @@ class Registry final : public daemon::DriverSectionReader {
   std::string type_{};
   bool ok_{false};
   plant::PlantConfig plant_{};
+  modbus::ModbusConfig modbus_{};
 };
 
 }  // namespace selfsense::drivers

@@ -23,5 +23,6 @@ void add_feedforward_command(CLI::App& app);
 void add_import_command(CLI::App& app);
 void add_check_config_command(CLI::App& app);
 void add_ctl_command(CLI::App& app);
+void add_sim_device_command(CLI::App& app);
 
 }  // namespace selfsense::cli

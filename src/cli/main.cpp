@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   selfsense::cli::add_import_command(app);
   selfsense::cli::add_check_config_command(app);
   selfsense::cli::add_ctl_command(app);
+  selfsense::cli::add_sim_device_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
