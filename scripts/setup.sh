@@ -22,6 +22,7 @@ packages=(
   nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
+  mbpoll
 )
 
 install_missing() {

@@ -42,7 +42,7 @@
 #include "selfsense/runtime/driver.hpp"
 #include "selfsense/runtime/latest_value.hpp"
 
-struct _modbus;  // libmodbus's context (modbus_t)
+struct _modbus;  // NOLINT(bugprone-reserved-identifier): libmodbus's context (modbus_t)
 
 namespace selfsense::drivers::modbus {
 
@@ -142,7 +142,7 @@ class ModbusDriver final : public runtime::Driver {
 
   // Bus thread only.
   std::array<Block, 2> blocks_{};  // [input, holding]
-  std::array<std::uint16_t, 2 * 125> words_{};
+  std::array<std::uint16_t, std::size_t{2} * 125> words_{};
   std::uint64_t written_seq_{0};
   std::uint64_t published_seq_{0};
   std::int64_t published_ns_{0};

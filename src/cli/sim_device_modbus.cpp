@@ -108,7 +108,7 @@ struct Span {
 class Device final {
  public:
   Device(const SimDeviceOptions& options, mb::RegisterMap map)
-      : map_(std::move(map)),
+      : map_(map),
         transducer_(plant::load_plant_file(options.plant).plant),
         period_ns_(std::llround(1e9 / options.rate_hz)) {
     std::string why;
@@ -180,8 +180,9 @@ void set_priority(int priority) {
   sched_param param{};
   param.sched_priority = priority;
   if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
-    std::fprintf(stderr, "sim-device: warning: SCHED_FIFO %d refused (%s); normal scheduling\n",
-                 priority, std::strerror(errno));
+    static_cast<void>(
+        std::fprintf(stderr, "sim-device: warning: SCHED_FIFO %d refused (%s); normal scheduling\n",
+                     priority, std::strerror(errno)));
   }
 }
 
@@ -205,15 +206,15 @@ bool wait_until(std::vector<pollfd>& fds, std::int64_t deadline, const StopSigna
 }
 
 void finish(const Device& device, const ServerCounts& counts) {
-  std::printf(
+  static_cast<void>(std::printf(
       "sim-device: stopped after %llu updates, %llu requests, %llu connections, %llu bus errors, "
       "%llu bad commands\n",
       static_cast<unsigned long long>(device.updates()),
       static_cast<unsigned long long>(counts.requests),
       static_cast<unsigned long long>(counts.connections),
       static_cast<unsigned long long>(counts.errors),
-      static_cast<unsigned long long>(device.bad_commands()));
-  std::fflush(stdout);
+      static_cast<unsigned long long>(device.bad_commands())));
+  static_cast<void>(std::fflush(stdout));
 }
 
 // Next update deadline; a late update is not repeated to catch up.
@@ -242,9 +243,9 @@ int serve_modbus_tcp(const SimDeviceOptions& options, const std::string& host, i
   socklen_t length = sizeof(bound);
   getsockname(listener, reinterpret_cast<sockaddr*>(&bound), &length);  // NOLINT: sockets API
   const int actual = ntohs(reinterpret_cast<sockaddr_in*>(&bound)->sin_port);  // NOLINT
-  std::printf("sim-device: modbus-tcp on %s:%d, %g Hz, plant %s\n", host.c_str(), actual,
-              options.rate_hz, options.plant.string().c_str());
-  std::fflush(stdout);
+  static_cast<void>(std::printf("sim-device: modbus-tcp on %s:%d, %g Hz, plant %s\n", host.c_str(),
+                                actual, options.rate_hz, options.plant.string().c_str()));
+  static_cast<void>(std::fflush(stdout));
 
   std::vector<pollfd> fds{pollfd{listener, POLLIN, 0}};
   std::array<std::uint8_t, MODBUS_TCP_MAX_ADU_LENGTH> query{};
@@ -305,10 +306,10 @@ int serve_modbus_rtu(const SimDeviceOptions& options, const std::string& device_
   if (modbus_connect(ctx.get()) != 0) {
     throw std::runtime_error("--modbus-rtu " + device_path + ": " + modbus_strerror(errno));
   }
-  std::printf("sim-device: modbus-rtu on %s, unit %d, %d baud, %g Hz, plant %s\n",
-              device_path.c_str(), options.unit_id, options.baud, options.rate_hz,
-              options.plant.string().c_str());
-  std::fflush(stdout);
+  static_cast<void>(std::printf("sim-device: modbus-rtu on %s, unit %d, %d baud, %g Hz, plant %s\n",
+                                device_path.c_str(), options.unit_id, options.baud, options.rate_hz,
+                                options.plant.string().c_str()));
+  static_cast<void>(std::fflush(stdout));
   std::vector<pollfd> fds{pollfd{modbus_get_socket(ctx.get()), POLLIN, 0}};
   std::array<std::uint8_t, MODBUS_RTU_MAX_ADU_LENGTH> query{};
   ServerCounts counts;
