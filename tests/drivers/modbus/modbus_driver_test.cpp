@@ -32,6 +32,7 @@
 
 #include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
+#include "support/allocation_counter.hpp"
 
 namespace selfsense::drivers::modbus {
 namespace {
@@ -179,6 +180,28 @@ TEST(ModbusDriver, TcpReadsTheSimulatedTransducerAndWritesItsCommand) {
   EXPECT_EQ(device.stop(SIGTERM), 0) << "sim-device exits 0 on SIGTERM";
 }
 
+TEST(ModbusDriver, ReadAndWriteNeitherAllocateNorLockWhileTheBusRuns) {
+  SimDevice device({"--modbus-tcp", "127.0.0.1:0"});
+  auto d = start(tcp_config(device.port()));
+  ASSERT_GT(run_for(*d, 300ms, 5e5).count(DriverStatus::kOk), 100);
+  int ok = 0;
+  std::size_t allocations = 0;
+  std::size_t locks = 0;
+  {
+    const test::AllocationCounter counter;
+    for (int i = 0; i < 20000; ++i) {
+      runtime::InputSample in;
+      ok += d->read(in) == DriverStatus::kOk ? 1 : 0;
+      static_cast<void>(d->write({5e5 + i}));
+    }
+    allocations = counter.count();
+    locks = counter.locks();
+  }
+  EXPECT_GT(ok, 0);
+  EXPECT_EQ(allocations, 0U) << "in read()/write() or on the bus thread";
+  EXPECT_EQ(locks, 0U);
+}
+
 TEST(ModbusDriver, TcpDisconnectIsCountedAndTheLinkComesBack) {
   auto device =
       std::make_unique<SimDevice>(std::vector<std::string>{"--modbus-tcp", "127.0.0.1:0"});
@@ -224,6 +247,18 @@ TEST(ModbusDriver, ExceptionResponsesAreCountedAsDeviceFaults) {
   EXPECT_GT(d->exception_responses(), 10U);
   EXPECT_EQ(d->counters().device_faults, d->exception_responses());
   EXPECT_TRUE(d->connected()) << "an exception is an answer: the link stays";
+}
+
+TEST(ModbusDriver, ValuesOutsideTheirRangeAreBadDataNotOk) {
+  SimDevice device({"--modbus-tcp", "127.0.0.1:0"});
+  ModbusConfig c = tcp_config(device.port());
+  c.registers.e.max = 1.0e5;  // the command below drives E to 5e5
+  auto d = start(c);
+  static_cast<void>(run_for(*d, 600ms, 5e5));
+  const Tally t = run_for(*d, 400ms, 5e5);
+  EXPECT_EQ(t.count(DriverStatus::kOk), 0);
+  EXPECT_GT(t.count(DriverStatus::kBadData), 100);
+  EXPECT_GT(d->counters().bad_data, 50U);
 }
 
 // A TCP server that answers every request with random bytes.
