@@ -40,6 +40,7 @@
 
 #include "modbus/modbus_config.hpp"
 #include "selfsense/runtime/driver.hpp"
+#include "selfsense/runtime/latency_histogram.hpp"
 #include "selfsense/runtime/latest_value.hpp"
 
 struct _modbus;  // NOLINT(bugprone-reserved-identifier): libmodbus's context (modbus_t)
@@ -100,6 +101,13 @@ class ModbusDriver final : public runtime::Driver {
     return device_faults_.load(std::memory_order_relaxed);
   }
   [[nodiscard]] BusStats bus_stats() const noexcept;
+  // Distributions of the same figures; owned by the bus thread: read them after deactivate().
+  [[nodiscard]] const runtime::LatencyHistogram& latency_histogram() const noexcept {
+    return latency_hist_;
+  }
+  [[nodiscard]] const runtime::LatencyHistogram& poll_histogram() const noexcept {
+    return poll_hist_;
+  }
   // False when `priority` was asked for and the system refused it (the thread runs anyway).
   [[nodiscard]] bool bus_priority_granted() const noexcept { return priority_granted_; }
   [[nodiscard]] const ModbusConfig& config() const noexcept { return config_; }
@@ -147,6 +155,8 @@ class ModbusDriver final : public runtime::Driver {
   std::uint64_t published_seq_{0};
   std::int64_t published_ns_{0};
   int failures_in_row_{0};
+  runtime::LatencyHistogram latency_hist_{};
+  runtime::LatencyHistogram poll_hist_{};
   bool ever_connected_{false};
 
   std::atomic<std::uint64_t> reads_{0};
