@@ -234,6 +234,8 @@ int serve_modbus_tcp(const SimDeviceOptions& options, const std::string& host, i
       modbus_new_tcp_pi(host.c_str(), std::to_string(port).c_str()));
   if (!ctx) throw std::runtime_error("--modbus-tcp: " + std::string(modbus_strerror(errno)));
   modbus_set_slave(ctx.get(), options.unit_id);
+  // A client that stops mid-frame holds the server (and the plant's updates) this long at most.
+  modbus_set_byte_timeout(ctx.get(), 0, 10'000);
   const int listener = modbus_tcp_pi_listen(ctx.get(), 8);
   if (listener < 0) {
     throw std::runtime_error("--modbus-tcp " + host + ":" + std::to_string(port) + ": " +
@@ -303,6 +305,7 @@ int serve_modbus_rtu(const SimDeviceOptions& options, const std::string& device_
       modbus_new_rtu(device_path.c_str(), options.baud, 'N', 8, 1));
   if (!ctx) throw std::runtime_error("--modbus-rtu: " + std::string(modbus_strerror(errno)));
   modbus_set_slave(ctx.get(), options.unit_id);
+  modbus_set_byte_timeout(ctx.get(), 0, 10'000);
   if (modbus_connect(ctx.get()) != 0) {
     throw std::runtime_error("--modbus-rtu " + device_path + ": " + modbus_strerror(errno));
   }
