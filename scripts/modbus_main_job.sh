@@ -12,7 +12,7 @@ mkdir -p "$out"
   --plant "$root/config/plant/daemon.yaml" >"$out/sim_device.log" 2>&1 &
 device=$!
 trap 'kill -TERM "$device" 2>/dev/null || true' EXIT
-for _ in $(seq 100); do grep -q 'modbus-tcp on' "$out/sim_device.log" && break; sleep 0.05; done
+for _ in $(seq 100); do grep -qs 'modbus-tcp on' "$out/sim_device.log" && break; sleep 0.05; done
 grep -q 'modbus-tcp on' "$out/sim_device.log" || { cat "$out/sim_device.log" >&2; exit 1; }
 SELFSENSE_MAIN_JOB_CONFIG=$root/config/modbus-sim.yaml bash "$root/scripts/main_job.sh" "$build" "$out"
 kill -TERM "$device"

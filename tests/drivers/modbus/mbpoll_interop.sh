@@ -16,7 +16,7 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 "$cli" sim-device --modbus-tcp 127.0.0.1:0 --plant "$root/config/plant/daemon.yaml" --rate 1000 >"$out/device.log" 2>&1 &
 pid=$!
 trap 'kill -KILL $pid 2>/dev/null || true; rm -rf "$out"' EXIT
-for _ in $(seq 100); do grep -q 'modbus-tcp on' "$out/device.log" && break; sleep 0.05; done
+for _ in $(seq 100); do grep -qs 'modbus-tcp on' "$out/device.log" && break; sleep 0.05; done
 port=$(sed -n 's/.*modbus-tcp on 127.0.0.1:\([0-9]*\),.*/\1/p' "$out/device.log")
 [ -n "$port" ] || fail "sim-device did not start: $(cat "$out/device.log")"
 # -0: addresses from 0 as in the register map; -B: high word first; -1: one poll.
