@@ -195,6 +195,29 @@ TEST(ModbusDriver, ExceptionResponsesAreCountedAsDeviceFaults) {
   EXPECT_TRUE(d->connected()) << "an exception is an answer: the link stays";
 }
 
+TEST(ModbusDriver, ReadsWithoutANewSampleAreStaleBeyondTheAllowance) {
+  SimDevice device({"--modbus-tcp", "127.0.0.1:0"});
+  ModbusConfig c = tcp_config(device.port());
+  c.poll_rate_hz = 100.0;  // a new sample every 10 reads of the 1 kHz loop below
+  c.sample_timeout_s = 0.5;
+  c.stale_reads = 0;
+  auto strict = start(c);
+  static_cast<void>(run_for(*strict, 200ms, 0.0));
+  const Tally t = run_for(*strict, 500ms, 0.0);
+  const int reads = t.count(DriverStatus::kOk) + t.count(DriverStatus::kStale);
+  EXPECT_GT(t.count(DriverStatus::kStale), reads / 2) << "strict: every repeated sample";
+  EXPECT_GT(t.count(DriverStatus::kOk), 10) << "each new sample once";
+  EXPECT_GE(strict->counters().stale, static_cast<std::uint64_t>(t.count(DriverStatus::kStale)));
+  strict->deactivate();
+  c.stale_reads = 40;
+  auto held = start(c);
+  static_cast<void>(run_for(*held, 200ms, 0.0));
+  const Tally h = run_for(*held, 500ms, 0.0);
+  EXPECT_EQ(h.count(DriverStatus::kStale), 0) << "up to 40 repeats are held";
+  EXPECT_GT(h.count(DriverStatus::kOk), 300);
+  EXPECT_GT(held->counters().stale, 200U) << "held repeats still count";
+}
+
 TEST(ModbusDriver, ValuesOutsideTheirRangeAreBadDataNotOk) {
   SimDevice device({"--modbus-tcp", "127.0.0.1:0"});
   ModbusConfig c = tcp_config(device.port());
