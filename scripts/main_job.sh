@@ -13,12 +13,13 @@ daemon=$build/src/selfsensed/selfsensed
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 
-# The shipped configuration with this run's paths.
+# The shipped configuration with this run's paths (SELFSENSE_MAIN_JOB_CONFIG: another one of
+# config/, e.g. config/modbus-sim.yaml through scripts/modbus_main_job.sh).
 config=$root/config/.main-job.yaml
-sed -e "s|directory: ../build/sim/recordings|directory: $out/recordings|" \
-  -e "s|path: ../build/sim/control.sock|path: $out/control.sock|" \
-  -e "s|prometheus_file: ../build/sim/selfsensed.prom|prometheus_file: $out/selfsensed.prom|" \
-  "$root/config/sim.yaml" >"$config"
+sed -e "s|directory: ../build/[a-z-]*/recordings|directory: $out/recordings|" \
+  -e "s|path: ../build/[a-z-]*/control.sock|path: $out/control.sock|" \
+  -e "s|prometheus_file: ../build/[a-z-]*/selfsensed.prom|prometheus_file: $out/selfsensed.prom|" \
+  "${SELFSENSE_MAIN_JOB_CONFIG:-$root/config/sim.yaml}" >"$config"
 "$cli" check-config "$config"
 
 "$daemon" --config "$config" >"$out/daemon.log" 2>&1 &

@@ -23,6 +23,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
   zlib1g-dev chromium fonts-liberation  # the diagnosis report's browser test (tests/cli)
+  mbpoll
 )
 
 install_missing() {

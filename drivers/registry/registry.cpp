@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "can/can_driver.hpp"
+#include "modbus/modbus_driver.hpp"
 #include "selfsense/io/yaml_map.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
 #include "sim/simulated_transducer.hpp"
@@ -44,7 +45,7 @@ void read_simulated(io::YamlMap& driver, const daemon::DaemonConfig& config,
 }  // namespace
 
 std::string driver_types() {
-  return "simulated, can";
+  return "simulated, can, modbus-tcp, modbus-rtu";
 }
 
 void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
@@ -56,6 +57,10 @@ void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
   } else if (type_ == "can") {
     can_ = can::CanConfig{};
     can::read_can_config(driver, config.loop.rate_hz, can_, problems);
+  } else if (type_ == "modbus-tcp" || type_ == "modbus-rtu") {
+    modbus::read_modbus_section(
+        driver, type_ == "modbus-tcp" ? modbus::Transport::kTcp : modbus::Transport::kRtu, modbus_,
+        problems);
   } else {
     problems.push_back(
         driver.locate("driver.type: '" + type_ + "' is not one of " + driver_types()));
@@ -66,6 +71,9 @@ void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
 std::unique_ptr<runtime::Driver> Registry::create() const {
   if (!ok_) throw std::logic_error("driver registry: no valid driver section was read");
   if (type_ == "can") return std::make_unique<can::CanDriver>(can_);
+  if (type_ == "modbus-tcp" || type_ == "modbus-rtu") {
+    return std::make_unique<modbus::ModbusDriver>(modbus_);
+  }
   return std::make_unique<SimulatedTransducer>(plant_);
 }
 

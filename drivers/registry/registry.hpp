@@ -7,6 +7,7 @@
 //   type: can           SocketCAN (drivers/can, docs/drivers/can.md)
 //     interface, fd, rx_timeout_ms, stale_cycles, error_frames, signals: {e, d, s_ref, t_ref,
 //     command}          see drivers/can/can_config.hpp
+//   type: modbus-tcp | modbus-rtu   the Modbus driver (drivers/modbus, docs/drivers/modbus.md)
 #pragma once
 
 #include <memory>
@@ -14,13 +15,14 @@
 #include <vector>
 
 #include "can/can_config.hpp"
+#include "modbus/modbus_config.hpp"
 #include "selfsense/daemon/config.hpp"
 #include "selfsense/plant/config.hpp"
 #include "selfsense/runtime/driver.hpp"
 
 namespace selfsense::drivers {
 
-// Every driver type, for messages: "simulated, can".
+// Every driver type, for messages: "simulated, can, modbus-tcp, modbus-rtu".
 [[nodiscard]] std::string driver_types();
 
 class Registry final : public daemon::DriverSectionReader {
@@ -37,6 +39,7 @@ class Registry final : public daemon::DriverSectionReader {
   bool ok_{false};
   plant::PlantConfig plant_{};
   can::CanConfig can_{};
+  modbus::ModbusConfig modbus_{};
 };
 
 }  // namespace selfsense::drivers

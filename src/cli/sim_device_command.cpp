@@ -1,74 +1,132 @@
-// `selfsense sim-device`: the simulated transducer served over a bus (contracts.md, "simulated
-// device"), one bus per run. This file only parses the options and dispatches to the server of
-// the chosen bus; each bus's server lives in its own file (sim_device_can.cpp, ...).
+// `selfsense sim-device --can IFACE | --modbus-tcp HOST:PORT | --modbus-rtu DEVICE [...]`
+// (contracts.md, "simulated device"): the simulated transducer served over a bus, paced in real
+// time, until SIGINT or SIGTERM (exit 0) or --duration. This file only parses the options and
+// dispatches to the chosen bus's server (sim_device_can.cpp, sim_device_modbus.cpp).
 #include <CLI/CLI.hpp>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "commands.hpp"
+#include "sim_device.hpp"
 #include "sim_device_can.hpp"
 
 namespace selfsense::cli {
 namespace {
 
-struct SimDeviceOptions {
+struct SimDeviceArgs {
   // The bus: exactly one.
   std::string can{};  // --can IFACE
-  // Common to every bus.
-  std::filesystem::path config{};
+  std::string modbus_tcp{};
+  std::string modbus_rtu{};
+  // Common; --plant applies to every bus (Modbus defaults to config/plant/daemon.yaml, CAN to
+  // the plant's defaults).
   std::filesystem::path plant{};
   double rate_hz{1000.0};
+  // Modbus.
+  SimDeviceOptions modbus{};
+  // CAN.
+  std::filesystem::path config{};
   double duration_s{0.0};
   double command_timeout_ms{100.0};
 };
 
-// ---- per-bus dispatch -------------------------------------------------------------------------
+// ---- CAN --------------------------------------------------------------------------------------
 
-int run_can(const SimDeviceOptions& o) {
-  if (o.config.empty()) {
+int run_can(const SimDeviceArgs& a) {
+  if (a.config.empty()) {
     throw std::runtime_error(
         "sim-device --can: --config C.yaml (a daemon configuration with "
         "driver.type can: the frame layout) is required");
   }
   CanSimDeviceOptions c;
-  c.interface = o.can;
-  c.config = o.config;
-  c.plant = o.plant;
-  c.rate_hz = o.rate_hz;
-  c.duration_s = o.duration_s;
-  c.command_timeout_ms = o.command_timeout_ms;
+  c.interface = a.can;
+  c.config = a.config;
+  c.plant = a.plant;
+  c.rate_hz = a.rate_hz;
+  c.duration_s = a.duration_s;
+  c.command_timeout_ms = a.command_timeout_ms;
   return run_can_sim_device(c);
 }
 
-int dispatch(const SimDeviceOptions& o) {
-  const int buses = o.can.empty() ? 0 : 1;
-  if (buses != 1) throw std::runtime_error("sim-device: give exactly one bus: --can IFACE");
-  if (!o.can.empty()) return run_can(o);
-  return 2;
+// ---- Modbus -----------------------------------------------------------------------------------
+
+// "HOST:PORT" (the last colon splits; PORT 0 picks a free port and prints it).
+std::pair<std::string, int> host_port(const std::string& s) {
+  const std::size_t colon = s.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == s.size()) {
+    throw std::invalid_argument("--modbus-tcp: '" + s + "' is not HOST:PORT");
+  }
+  std::size_t used = 0;
+  const int port = std::stoi(s.substr(colon + 1), &used);
+  if (used != s.size() - colon - 1 || port < 0 || port > 65535) {
+    throw std::invalid_argument("--modbus-tcp: port '" + s.substr(colon + 1) +
+                                "' must be within [0, 65535]");
+  }
+  return {s.substr(0, colon), port};
+}
+
+int run_modbus(const SimDeviceArgs& a) {
+  SimDeviceOptions o = a.modbus;
+  if (!a.plant.empty()) o.plant = a.plant;
+  o.rate_hz = a.rate_hz;
+  if (!a.modbus_tcp.empty()) {
+    const auto [host, port] = host_port(a.modbus_tcp);
+    return serve_modbus_tcp(o, host, port);
+  }
+  return serve_modbus_rtu(o, a.modbus_rtu);
+}
+
+int dispatch(const SimDeviceArgs& a) {
+  const int buses = static_cast<int>(!a.can.empty()) + static_cast<int>(!a.modbus_tcp.empty()) +
+                    static_cast<int>(!a.modbus_rtu.empty());
+  if (buses != 1) {
+    throw std::runtime_error(
+        "sim-device: give exactly one bus: --can IFACE, --modbus-tcp HOST:PORT or "
+        "--modbus-rtu DEVICE");
+  }
+  if (!a.can.empty()) return run_can(a);
+  return run_modbus(a);
 }
 
 }  // namespace
 
 void add_sim_device_command(CLI::App& app) {
-  auto o = std::make_shared<SimDeviceOptions>();
+  auto a = std::make_shared<SimDeviceArgs>();
   CLI::App* cmd = app.add_subcommand(
       "sim-device", "Serve the simulated transducer over a bus, paced in real time");
   // Buses.
-  cmd->add_option("--can", o->can, "SocketCAN interface (e.g. vcan0): a CAN node");
+  cmd->add_option("--can", a->can, "SocketCAN interface (e.g. vcan0): a CAN node");
+  cmd->add_option("--modbus-tcp", a->modbus_tcp,
+                  "Modbus TCP server on HOST:PORT (PORT 0: a free port, printed)");
+  cmd->add_option("--modbus-rtu", a->modbus_rtu, "Modbus RTU server on a serial DEVICE");
   // Common.
-  cmd->add_option("--config", o->config,
-                  "Daemon configuration whose driver section gives the frame layout (CAN)");
-  cmd->add_option("--plant", o->plant, "Plant configuration (config/plant/); default: defaults");
-  cmd->add_option("--rate", o->rate_hz, "Frames per second (must divide the plant's rate)")
+  cmd->add_option("--plant", a->plant,
+                  "Plant configuration (YAML); default: config/plant/daemon.yaml for Modbus, "
+                  "the plant's defaults for CAN");
+  cmd->add_option("--rate", a->rate_hz, "Device updates per second (must divide the plant's rate)")
       ->capture_default_str();
-  cmd->add_option("--duration", o->duration_s, "Seconds to run; 0: until SIGINT/SIGTERM")
+  // CAN.
+  cmd->add_option("--config", a->config,
+                  "CAN: daemon configuration whose driver section gives the frame layout");
+  cmd->add_option("--duration", a->duration_s, "CAN: seconds to run; 0: until SIGINT/SIGTERM")
       ->capture_default_str();
-  cmd->add_option("--command-timeout-ms", o->command_timeout_ms,
-                  "No command for this long: the node applies E = 0")
+  cmd->add_option("--command-timeout-ms", a->command_timeout_ms,
+                  "CAN: no command for this long: the node applies E = 0")
       ->capture_default_str();
-  cmd->callback([o] {
-    const int status = dispatch(*o);
+  // Modbus.
+  cmd->add_option("--unit-id", a->modbus.unit_id, "Modbus unit (slave) address")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 247));
+  cmd->add_option("--baud", a->modbus.baud, "Modbus RTU baud rate")->capture_default_str();
+  cmd->add_option("--priority", a->modbus.priority,
+                  "Modbus: SCHED_FIFO priority (1..99; refused without the right: a warning); "
+                  "0: normal")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 99));
+  cmd->callback([a] {
+    const int status = dispatch(*a);
     if (status != 0) throw CommandExit{status};
   });
 }
