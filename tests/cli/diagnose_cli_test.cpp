@@ -42,18 +42,18 @@ class DiagnoseCli : public ::testing::Test {
     fs::create_directories(dir);
     const std::string d = dir.string() + "/";
     ASSERT_EQ(run(dir, "plant --config " + kData +
-                            "bench_base.yaml --excitation mix --seed 11 --out " + d + "base.csv"),
+                           "bench_base.yaml --excitation mix --seed 11 --out " + d + "base.csv"),
               0);
     ASSERT_EQ(
         run(dir, "plant --config " + kData +
-                      "bench_leakage_creep.yaml --excitation mix --seed 21 --out " + d + "fit.csv"),
+                     "bench_leakage_creep.yaml --excitation mix --seed 21 --out " + d + "fit.csv"),
         0);
     ASSERT_EQ(
         run(dir, "plant --config " + kData +
-                      "bench_leakage_creep.yaml --excitation mix --seed 22 --out " + d + "val.csv"),
+                     "bench_leakage_creep.yaml --excitation mix --seed 22 --out " + d + "val.csv"),
         0);
     ASSERT_EQ(run(dir, "identify --recording " + d +
-                            "base.csv --structure hysteresis-creep --out " + d + "base_model.yaml"),
+                           "base.csv --structure hysteresis-creep --out " + d + "base_model.yaml"),
               0);
   }
   static void TearDownTestSuite() { fs::remove_all(dir); }
@@ -97,10 +97,10 @@ TEST_F(DiagnoseCli, NamesModelsAndShowsTheFitImproveOnValidationData) {
   }
   // The improved model runs in the tools (and so in the daemon, same runtime model).
   EXPECT_EQ(run(dir, "simulate --model " + path("improved.yaml") + " --recording " +
-                          path("val.csv") + " --out " + path("sim.csv")),
+                         path("val.csv") + " --out " + path("sim.csv")),
             0);
   EXPECT_EQ(run(dir, "reconstruct --model " + path("improved.yaml") + " --recording " +
-                          path("val.csv") + " --out " + path("rec.csv")),
+                         path("val.csv") + " --out " + path("rec.csv")),
             0);
   EXPECT_NE(read(path("improved.yaml")).find("leakage_tau_s"), std::string::npos);
   const std::string html = read(path("d.html"));
