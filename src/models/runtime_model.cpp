@@ -365,7 +365,8 @@ Simulation::Output Simulation::kernel_step(double drive, double stress) noexcept
     const StressHysteresisForward::Output o = std::get<Vectorial>(impl_)->step(drive, stress);
     out = {o.sensed, o.strain, SampleStatus::kOk};
   }
-  const double base_sensed = out.sensed;
+  // A model without a sensor side has NaN there; the electrostriction term then has nothing.
+  const double base_sensed = std::isnan(out.sensed) ? 0.0 : out.sensed;
   if (sensed_fix_) {
     out.sensed = sensed_fix_->step({out.sensed, drive, stress, temperature_, base_sensed,
                                     out.sensed - sensed_coupling_ * stress});

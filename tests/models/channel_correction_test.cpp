@@ -161,6 +161,20 @@ TEST(ChannelCorrection, ReconstructionRefusesASensedCorrectionWithoutInverse) {
   EXPECT_NO_THROW(Simulation sim(m));
 }
 
+// An actuator-only model has no sensed output (NaN): the strain correction must not take it in.
+TEST(ChannelCorrection, ActuatorOnlyModelStaysFinite) {
+  TransducerModel m = test::typical_transducer(kTs);
+  m.sensor.reset();
+  ChannelCorrection c;
+  c.dynamics_frequency_hz = 900.0;
+  c.dynamics_damping = 0.1;
+  m.strain_correction = c;
+  Simulation sim(m);
+  for (int k = 0; k < 100; ++k) {
+    EXPECT_TRUE(std::isfinite(sim.step(1e6 * std::sin(0.1 * k), 0.0).strain)) << k;
+  }
+}
+
 TEST(ChannelCorrection, StepsDoNotAllocate) {
   TransducerModel m = corrected_model();
   const test::TransducerData data = test::transducer_data(m, 2000, kTs, 5);
