@@ -41,20 +41,10 @@ diagnosis::Signals to_signals(const FieldSignals& f, models::Drive drive) {
   return {f.drive(drive), f.sensed(drive), f.s, f.stress, f.temp, f.sample_time};
 }
 
-// Forward and reconstruction through the runtime model, with the recorded temperature.
-ModelRuns runs_of(const models::TransducerModel& model, const FieldSignals& f) {
-  ModelRuns runs = run_model(model, f, true, true);
-  if (!f.temp.empty() && (model.sensed_correction || model.strain_correction)) {
-    const diagnosis::Outputs o = diagnosis::simulate(model, to_signals(f, model.drive()));
-    if (!runs.sensed.empty()) runs.sensed = o.sensed;
-    if (!runs.strain.empty()) runs.strain = o.strain;
-  }
-  return runs;
-}
-
+// Forward and reconstruction through the runtime model (with the recorded temperature).
 std::vector<ChannelFigures> figures_of(const models::TransducerModel& model,
                                        const FieldSignals& f) {
-  return figures(model, f, runs_of(model, f), 0, f.size());
+  return figures(model, f, run_model(model, f, true, true), 0, f.size());
 }
 
 std::vector<ReportFigure> report_figures(const std::vector<ChannelFigures>& figs) {

@@ -23,6 +23,7 @@ ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& si
     if (actuator) runs.strain.resize(n);
     runs.forward_status.resize(n);
     for (std::size_t k = 0; k < n; ++k) {
+      if (!signals.temp.empty()) sim.set_temperature(signals.temp[k]);
       const double stress = signals.stress.empty() ? 0.0 : signals.stress[k];
       const models::Simulation::Output out = sim.step(x[k], stress);
       if (sensor) runs.sensed[k] = out.sensed;
@@ -38,6 +39,7 @@ ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& si
     if (rec.has_strain()) runs.strain_hat.resize(n);
     runs.estimate_status.resize(n);
     for (std::size_t k = 0; k < n; ++k) {
+      if (!signals.temp.empty()) rec.set_temperature(signals.temp[k]);
       const models::Reconstruction::Estimate est = rec.step(x[k], y[k]);
       runs.stress_hat[k] = est.stress;
       if (rec.has_strain()) runs.strain_hat[k] = est.strain;

@@ -29,7 +29,8 @@ struct ModelRuns {
 };
 
 // Forward with the recorded stress (0 where the recording has none); reconstruction where the
-// model has a sensor side with a coupling and the recording the sensed channel.
+// model has a sensor side with a coupling and the recording the sensed channel. The recorded
+// temperature, where there is one, feeds the corrections' temperature terms.
 [[nodiscard]] ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& signals,
                                   bool forward, bool reconstruct);
 // A sensor side with a stress coupling (or the stress-dependent model's sensor side).

@@ -106,42 +106,87 @@ struct ChannelData {
   bool sensed{false};
   std::span<const double> recorded;
   std::vector<double> base;
-  double coupling{0.0};  // of the stress in the model's side
+  double coupling{0.0};                    // of the stress in the model's side
+  std::span<const double> sensed_model{};  // the model's sensed output (electrostriction)
 };
 
 // Share of the residual variance removed in each held-out block; the median is the figure a
 // candidate must reach (one block it fits by chance does not carry it).
+// Which samples fit and which judge: sample k lies in block (k blocks) / n; even blocks fit,
+// odd ones judge. Samples where the model gave no finite output do neither.
+struct Rows {
+  std::vector<bool> fit{};
+  std::vector<bool> judge{};
+  std::vector<std::size_t> block{};
+  std::size_t blocks{0};
+};
+
+Rows make_rows(const std::vector<bool>& usable, std::size_t blocks) {
+  const std::size_t n = usable.size();
+  Rows r;
+  r.blocks = blocks;
+  r.fit.resize(n);
+  r.judge.resize(n);
+  r.block.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    r.block[k] = (k * blocks) / n;
+    r.fit[k] = usable[k] && r.block[k] % 2 == 0;
+    r.judge[k] = usable[k] && r.block[k] % 2 == 1;
+  }
+  return r;
+}
+
+// Share of the residual variance removed in each held-out block; the median is the figure a
+// candidate must reach (one block it fits by chance does not carry it).
 double median_block_explains(std::span<const double> recorded, const std::vector<double>& before,
-                             const std::vector<double>& after, const std::vector<bool>& fit_rows,
-                             std::size_t blocks) {
-  const std::size_t n = recorded.size();
+                             const std::vector<double>& after, const Rows& rows) {
+  std::vector<double> e0(rows.blocks, 0.0);
+  std::vector<double> e1(rows.blocks, 0.0);
+  for (std::size_t k = 0; k < recorded.size(); ++k) {
+    if (!rows.judge[k]) continue;
+    e0[rows.block[k]] += (recorded[k] - before[k]) * (recorded[k] - before[k]);
+    e1[rows.block[k]] += (recorded[k] - after[k]) * (recorded[k] - after[k]);
+  }
   std::vector<double> share;
-  for (std::size_t b = 0; b < blocks; ++b) {
-    const std::size_t lo = b * n / blocks;
-    const std::size_t hi = (b + 1) * n / blocks;
-    if (lo >= hi || fit_rows[lo]) continue;
-    double e0 = 0.0;
-    double e1 = 0.0;
-    for (std::size_t k = lo; k < hi; ++k) {
-      e0 += (recorded[k] - before[k]) * (recorded[k] - before[k]);
-      e1 += (recorded[k] - after[k]) * (recorded[k] - after[k]);
-    }
-    share.push_back(e0 > 0.0 ? 1.0 - e1 / e0 : 0.0);
+  for (std::size_t b = 1; b < rows.blocks; b += 2) {
+    if (e0[b] > 0.0) share.push_back(1.0 - e1[b] / e0[b]);
   }
   if (share.empty()) return 0.0;
   std::sort(share.begin(), share.end());
   return share[share.size() / 2];
 }
 
-double held_out_sse(std::span<const double> recorded, const std::vector<double>& model,
-                    const std::vector<bool>& fit_rows) {
+double sse_over(std::span<const double> recorded, const std::vector<double>& model,
+                const std::vector<bool>& rows) {
   double sse = 0.0;
   for (std::size_t k = 0; k < recorded.size(); ++k) {
-    if (fit_rows[k]) continue;
+    if (!rows[k]) continue;
     const double e = recorded[k] - model[k];
     sse += e * e;
   }
   return sse;
+}
+
+// Non-finite model outputs (a rejected first sample) are held at the last finite value so no
+// filter state sees them; `usable` marks the samples that were finite.
+std::vector<bool> hold_finite(std::vector<double>& y) {
+  std::vector<bool> usable(y.size());
+  double last = 0.0;
+  for (const double v : y) {
+    if (std::isfinite(v)) {
+      last = v;
+      break;
+    }
+  }
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    usable[k] = std::isfinite(y[k]);
+    if (usable[k]) {
+      last = y[k];
+    } else {
+      y[k] = last;
+    }
+  }
+  return usable;
 }
 
 // Time since the drive last moved by more than 5 % of its range, log10 seconds.
@@ -273,12 +318,27 @@ void describe(Finding& f, const ChannelCorrection& c, const ChannelData& ch, con
     f.feature_name = "drive";
     f.feature.assign(s.drive.begin(), s.drive.end());
   } else if (f.effect == "electrostriction") {
-    f.evidence = "the recorded " + n +
-                 format(" follows the square of the polarization (Q = %.3g per (C/m^2)^2)",
-                        c.sensed_quadratic) +
-                 tail;
-    f.feature_name = "sensed output squared";
-    f.feature = before;
+    if (c.sensed_quadratic != 0.0) {  // field drive: P ~ the model's D
+      f.evidence = "the recorded " + n +
+                   format(
+                       " follows the square of the polarization (Q = %.3g m^4/C^2 on the "
+                       "model's D)",
+                       c.sensed_quadratic) +
+                   tail;
+    } else {  // charge drive: P ~ the imposed D
+      f.evidence = "the recorded " + n +
+                   format(
+                       " follows the square of the imposed polarization (butterfly: %.3g "
+                       "D^2 %+.3g D^3)",
+                       c.drive_quadratic, c.drive_cubic) +
+                   tail;
+    }
+    f.feature_name = "polarization squared [(C/m^2)^2]";
+    f.feature.resize(before.size());
+    for (std::size_t k = 0; k < before.size(); ++k) {
+      const double p = c.sensed_quadratic != 0.0 ? ch.sensed_model[k] : s.drive[k];
+      f.feature[k] = p * p;
+    }
   }
 }
 
@@ -289,6 +349,12 @@ double coupling_of(const std::optional<models::SideModel>& side) {
 bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, bool has_sensed,
                 bool charge_drive) {
   if (ch.sensed ? !c.on_sensed : !c.on_strain) return false;
+  const auto uses = [&](CorrectionTerm t) {
+    return std::find(c.terms.begin(), c.terms.end(), t) != c.terms.end();
+  };
+  // T^2 on the sensed channel is solved with the sensor coupling; leakage is a charge's.
+  if (uses(CorrectionTerm::kStressQuadratic) && ch.coupling == 0.0) return false;
+  if (uses(CorrectionTerm::kLeakage) && charge_drive) return false;
   switch (c.needs) {
     case Needs::kTemperature:
       return range_of(s.temperature) > 1.0;
@@ -368,7 +434,7 @@ bool overlaps(const Segment& a, const Segment& b) {
 // its extra parameters (BIC: n ln(SSE1/SSE0) + p ln n < -kLocalEvidence), and, refitted with
 // the accepted terms on the fitting blocks, does not make the held-out blocks worse.
 void local_pass(const ChannelData& ch, const identification::CorrectionSignals& cs,
-                const Signals& s, const std::vector<bool>& fit_rows,
+                const Signals& s, const Rows& rows, double original_sse,
                 std::vector<const Candidate*>& used, std::vector<CorrectionTerm>& accepted_terms,
                 ChannelCorrection& accepted, std::vector<double>& current, bool charge_drive,
                 std::vector<Finding>& findings) {
@@ -386,9 +452,10 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
     const auto seg_n = static_cast<double>(seg.end - seg.begin);
     const double before = segment_sse(ch.recorded, current, seg);
     if (known || seg_n < 16.0 || !(before > 0.0)) continue;
-    std::vector<bool> rows(n, false);
-    for (std::size_t k = seg.begin; k < seg.end; ++k)
-      rows[k] = true;
+    std::vector<bool> in_segment(n, false);
+    for (std::size_t k = seg.begin; k < seg.end; ++k) {
+      in_segment[k] = rows.fit[k] || rows.judge[k];
+    }
     identification::CorrectionSignals on_current = cs;
     on_current.y = current;
     const Candidate* best = nullptr;
@@ -398,7 +465,7 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
       if (std::find(used.begin(), used.end(), &c) != used.end()) continue;
       if (!applicable(c, ch, s, !cs.sensed.empty(), charge_drive)) continue;
       const identification::CorrectionFit local =
-          identification::fit_correction(on_current, c.terms, ChannelCorrection{}, rows);
+          identification::fit_correction(on_current, c.terms, ChannelCorrection{}, in_segment);
       const double after = segment_sse(ch.recorded, local.output, seg);
       const double bic = seg_n * std::log(std::max(after, 1e-300) / before) +
                          static_cast<double>(complexity(c.terms)) * std::log(seg_n);
@@ -418,18 +485,21 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
     }
     const std::vector<CorrectionTerm> terms = merged(accepted_terms, best->terms);
     identification::CorrectionFit joint =
-        identification::fit_correction(cs, terms, start, fit_rows);
-    const double held_before = held_out_sse(ch.recorded, current, fit_rows);
-    const double held_after = held_out_sse(ch.recorded, joint.output, fit_rows);
+        identification::fit_correction(cs, terms, start, rows.fit);
+    const double held_before = sse_over(ch.recorded, current, rows.judge);
+    const double held_after = sse_over(ch.recorded, joint.output, rows.judge);
     const double seg_after = segment_sse(ch.recorded, joint.output, seg);
     if (held_after > 1.02 * held_before || seg_after > 0.5 * before) continue;
     Finding f;
     f.effect = best->effect;
     f.channel = ch.name;
-    f.explains = 1.0 - seg_after / before;
+    // Contract: the share of the channel's residual variance (held-out blocks) it removes; the
+    // share within its stretch goes into the evidence.
+    f.explains = original_sse > 0.0 ? std::max(0.0, held_before - held_after) / original_sse : 0.0;
     f.where = {seg};
-    const std::string judged = format("in the one stretch of %.3g s that shows it (BIC %.3g)",
-                                      seg_n * s.sample_time, best_bic);
+    const std::string judged =
+        format("in the one stretch of %.3g s that shows it (%.0f %% there; BIC %.3g)",
+               seg_n * s.sample_time, 100.0 * (1.0 - seg_after / before), best_bic);
     describe(f, joint.correction, ch, s, current, joint.output, judged.c_str());
     findings.push_back(std::move(f));
     used.push_back(best);
@@ -468,7 +538,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
   models::TransducerModel base = model;
   base.sensed_correction.reset();
   base.strain_correction.reset();
-  const Outputs outputs = simulate(base, s);
+  Outputs outputs = simulate(base, s);
   const bool field = model.drive() == models::Drive::kField;
   const bool has_sensor = model.sensor || (model.vectorial && model.vectorial->sensor);
   const bool has_actuator = model.actuator || (model.vectorial && model.vectorial->actuator);
@@ -486,14 +556,16 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         "diagnose: the recording references none of the model's outputs (D or S)");
   }
 
-  std::vector<bool> fit_rows(n);
   const std::size_t blocks = std::max<std::size_t>(2, options.blocks);
-  for (std::size_t k = 0; k < n; ++k)
-    fit_rows[k] = ((k * blocks) / n) % 2 == 0;
+  // The channels hold their own copies; the electrostriction term reads this one.
+  static_cast<void>(hold_finite(outputs.sensed));
 
   Result result;
   result.improved = base;
-  for (const ChannelData& ch : channels) {
+  for (ChannelData& ch : channels) {
+    const Rows rows = make_rows(hold_finite(ch.base), blocks);
+    ch.sensed_model = outputs.sensed;
+    const std::vector<bool>& fit_rows = rows.fit;
     identification::CorrectionSignals cs;
     cs.y = ch.base;
     cs.recorded = ch.recorded;
@@ -514,7 +586,8 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     ChannelCorrection accepted;
     std::vector<double> current = ch.base;
     std::vector<const Candidate*> used;
-    double current_sse = held_out_sse(ch.recorded, current, fit_rows);
+    double current_sse = sse_over(ch.recorded, current, rows.judge);
+    const double original_sse = current_sse;
 
     for (std::size_t round = 0; round < options.max_effects && current_sse > 0.0; ++round) {
       struct Tried {
@@ -546,9 +619,8 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         }
         identification::CorrectionFit fit =
             identification::fit_correction(cs, terms, start, fit_rows);
-        const double sse = held_out_sse(ch.recorded, fit.output, fit_rows);
-        const double typical =
-            median_block_explains(ch.recorded, current, fit.output, fit_rows, blocks);
+        const double sse = sse_over(ch.recorded, fit.output, rows.judge);
+        const double typical = median_block_explains(ch.recorded, current, fit.output, rows);
         tried.push_back({&c, std::move(fit), 1.0 - sse / current_sse, typical});
       }
       if (tried.empty()) break;
@@ -564,12 +636,17 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       }
       std::swap(tried[0], tried[chosen]);
       const Tried& best = tried.front();
-      if (!(best.explains >= options.min_explains && best.typical >= options.min_explains)) break;
+      if (!(best.explains >= options.min_explains && best.typical >= options.min_explains &&
+            best.explains * current_sse >= options.min_share * original_sse)) {
+        break;
+      }
 
       Finding f;
       f.effect = best.candidate->effect;
       f.channel = ch.name;
-      f.explains = best.explains;
+      // Contract: the share of the channel's residual variance (held-out blocks) this physics
+      // removes, so the shares of several findings add up.
+      f.explains = original_sse > 0.0 ? best.explains * current_sse / original_sse : 0.0;
       for (std::size_t i = 1; i < tried.size(); ++i) {
         if (tried[i].explains >= options.alternative_share * best.explains) {
           f.alternatives.emplace_back(tried[i].candidate->effect);
@@ -579,6 +656,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       for (std::size_t k = 0; k < n; ++k)
         change[k] = best.fit.output[k] - current[k];
       f.where = large_segments(change, 1.5, 5);
+      if (f.where.empty()) f.where = {{0, n}};  // spread evenly: the whole record
       describe(f, best.fit.correction, ch, s, current, best.fit.output);
       result.findings.push_back(std::move(f));
 
@@ -586,10 +664,10 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       accepted = best.fit.correction;
       used.push_back(best.candidate);
       current = best.fit.output;
-      current_sse = held_out_sse(ch.recorded, current, fit_rows);
+      current_sse = sse_over(ch.recorded, current, rows.judge);
     }
 
-    local_pass(ch, cs, s, fit_rows, used, accepted_terms, accepted, current, !field,
+    local_pass(ch, cs, s, rows, original_sse, used, accepted_terms, accepted, current, !field,
                result.findings);
 
     ChannelResult out;

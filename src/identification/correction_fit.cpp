@@ -370,6 +370,9 @@ CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const Correct
     }
   }
   refine(s, terms, start, best_filters, evaluate);
+  if (best.coefficients.size() != static_cast<Eigen::Index>(columns.phi.size())) {
+    throw std::invalid_argument("fit_correction: no finite fit (non-finite signals?)");
+  }
   CorrectionFit fit;
   fit.correction = best_filters;
   fit.correction.temperature_reference_degc = s.temperature_reference_degc;

@@ -135,6 +135,13 @@ CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sam
   }
 }
 
+// 1 + gain terms, kept away from zero: a temperature gain fitted over a few kelvin must not flip
+// the sign or divide by zero far outside them.
+double CorrectionStage::gain_at(const Inputs& in) const noexcept {
+  const double dtheta = in.temperature - c_.temperature_reference_degc;
+  return std::max(1.0 + c_.gain + c_.temperature_gain_per_k * dtheta, 0.05);
+}
+
 double CorrectionStage::terms(const Inputs& in) const noexcept {
   const double dtheta = in.temperature - c_.temperature_reference_degc;
   const double x = in.drive;
@@ -170,7 +177,6 @@ double CorrectionStage::filters(double v) noexcept {
 }
 
 double CorrectionStage::step(const Inputs& in) noexcept {
-  const double dtheta = in.temperature - c_.temperature_reference_degc;
   const bool first = !started_;
   if (first) {
     started_ = true;
@@ -178,17 +184,17 @@ double CorrectionStage::step(const Inputs& in) noexcept {
     for (std::size_t j = 0; j < creep_count_; ++j)
       z_[j] = in.response;
   }
-  double v = in.y * (1.0 + c_.gain + c_.temperature_gain_per_k * dtheta) +
-             c_.stress_gain_per_pa * in.stress * in.response +
+  double v = in.y * gain_at(in) + c_.stress_gain_per_pa * in.stress * in.response +
              c_.stress_quadratic_per_pa2 * in.stress * in.stress + terms(in);
   for (std::size_t j = 0; j < creep_count_; ++j) {
     z_[j] += alpha_[j] * (in.response - z_[j]);
     v += c_.creep_weights[j] * (z_[j] - y0_);
   }
-  if (first) {  // the filters start in steady state at the first value
+  if (first) {  // the filters start at the first value: no ringing, no decay yet
     v1_ = v2_ = w1_ = w2_ = v;
     m_ = w_prev_ = v;
     line_.fill(v);
+    return v;
   }
   return filters(v);
 }
@@ -209,25 +215,20 @@ double CorrectionStage::delay_drive(double drive) noexcept {
 double CorrectionStage::invert(double measured, const Inputs& in) noexcept {
   double w = measured;
   if (leakage_) {
-    if (!started_) {
-      m_ = measured;
-      w_prev_ = measured;
+    if (started_) {
+      w = w_prev_ + (measured - leak_g_ * m_) / leak_c_;
     }
-    w = w_prev_ + (measured - leak_g_ * m_) / leak_c_;
-    m_ = measured;
+    m_ = measured;  // the forward's first output is its input: the inverse's too
     w_prev_ = w;
   }
   started_ = true;
-  const double dtheta = in.temperature - c_.temperature_reference_degc;
-  return (w - terms(in)) / (1.0 + c_.gain + c_.temperature_gain_per_k * dtheta);
+  return (w - terms(in)) / gain_at(in);
 }
 
 double CorrectionStage::solve_stress(double t_lin, double coupling,
                                      const Inputs& in) const noexcept {
   if (c_.stress_quadratic_per_pa2 == 0.0 || coupling == 0.0) return t_lin;
-  const double dtheta = in.temperature - c_.temperature_reference_degc;
-  const double q =
-      c_.stress_quadratic_per_pa2 / (1.0 + c_.gain + c_.temperature_gain_per_k * dtheta);
+  const double q = c_.stress_quadratic_per_pa2 / gain_at(in);
   // q T^2 + d T - d T_lin = 0, the root that tends to T_lin as q -> 0 (no cancellation).
   const double disc = coupling * coupling + 4.0 * q * coupling * t_lin;
   if (!(disc >= 0.0)) return -coupling / (2.0 * q);  // past the vertex: the nearest stress

@@ -1,6 +1,7 @@
 #include "selfsense/models/runtime_model.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -144,6 +145,23 @@ double reference_temperature(const TransducerModel& model) noexcept {
   return 25.0;
 }
 
+// A late reference sensor of S is the bench's, not the actuator's: the reconstruction's S_hat
+// does not take its delay (it would only add loop latency).
+std::optional<ChannelCorrection> without_delay(std::optional<ChannelCorrection> c) {
+  if (c) c->delay_s = 0.0;
+  return c;
+}
+
+// Hot swap of the same correction: its filters, lags and delay lines carry on (a restarted
+// leakage inverse would drop the charge it has restored so far).
+void adopt_stage(std::optional<CorrectionStage>& into,
+                 const std::optional<CorrectionStage>& from) noexcept {
+  if (!into || !from || !(into->correction() == from->correction())) return;
+  std::array<double, CorrectionStage::state_size()> state{};
+  from->save_state(state);
+  into->restore_state(state);
+}
+
 double coupling_of(const std::optional<SideModel>& side) noexcept {
   return (side && !side->linear_gains.empty()) ? side->linear_gains.front() : 0.0;
 }
@@ -245,13 +263,19 @@ Reconstruction::Reconstruction(const TransducerModel& model, const RuntimeOption
       identified_ts_(model.sample_time),
       last_{0.0, kNaN, SampleStatus::kOk},
       sensed_fix_(stage_for(model.sensed_correction, sample_time_)),
-      strain_fix_(stage_for(model.strain_correction, sample_time_)),
+      strain_fix_(stage_for(without_delay(model.strain_correction), sample_time_)),
       temperature_(reference_temperature(model)),
       sensed_coupling_(coupling_of(model.sensor)),
       strain_coupling_(coupling_of(model.actuator)) {
   std::string why;
   if (model.sensed_correction && !model.sensed_correction->invertible("corrections.sensed", &why)) {
     throw std::invalid_argument(why);
+  }
+  if (model.sensed_correction && model.sensed_correction->stress_quadratic_per_pa2 != 0.0 &&
+      sensed_coupling_ == 0.0) {
+    throw std::invalid_argument(
+        "corrections.sensed.stress_quadratic_per_pa2: needs a sensor side with a stress coupling "
+        "to be solved in the reconstruction");
   }
   identity_ = {model.structure, parameter_hash(model),
                kernel_size(impl_) + stages_size(sensed_fix_, strain_fix_)};
@@ -330,6 +354,8 @@ void Reconstruction::adopt_state(const Reconstruction& running) noexcept {
   } else {
     adopt_stream(from, std::get<Vectorial>(impl_)->stream(), scratch_);
   }
+  adopt_stage(sensed_fix_, running.sensed_fix_);
+  adopt_stage(strain_fix_, running.strain_fix_);
   held_ = running.held_;
   last_ = running.last_;
 }

@@ -79,6 +79,7 @@ bool PlantConfig::is_valid(std::string* why) const {
   const PermittivityConfig& pe = permittivity;
   c.positive("permittivity.reference_field_v_per_m", pe.reference_field_v_per_m);
   c.finite("permittivity.linear_coefficient", pe.linear_coefficient);
+  c.finite("electrostriction.q_m4_per_c2", electrostriction.q_m4_per_c2);
   c.finite("permittivity.quadratic_coefficient", pe.quadratic_coefficient);
 
   c.finite("stress.d_coefficient_per_pa", stress.d_coefficient_per_pa);

@@ -60,6 +60,11 @@ MechanicalResponse respond(const PlantConfig& c, double length_m, const Plant::S
   r.scales = with_stress(in.temperature, c.stress, t_c);
   r.s_inst = c.material.d33_m_per_v * r.scales.d * in.e_v_per_m +
              c.hysteresis.s_amplitude * r.scales.hysteresis * in.dp;
+  if (c.electrostriction.enabled) {
+    const double p = c.material.permittivity_f_per_m * r.scales.eps * in.e_v_per_m +
+                     c.hysteresis.d_amplitude_c_per_m2 * r.scales.hysteresis * in.dp;
+    r.s_inst += c.electrostriction.q_m4_per_c2 * p * p;
+  }
   const double s_free = r.s_inst + state.creep_s.peek(r.s_inst);
   const double compliance = c.material.compliance_m2_per_n * r.scales.compliance;
   const double k_s = c.geometry.cross_section_m2 / (compliance * length_m);

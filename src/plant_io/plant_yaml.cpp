@@ -102,6 +102,11 @@ void read_plant(YamlMap p, PlantConfig& c) {
     m->read("reference_field_v_per_m", c.permittivity.reference_field_v_per_m);
     m->finish();
   }
+  if (auto m = p.optional_map("electrostriction")) {
+    m->read("enabled", c.electrostriction.enabled);
+    m->read("q_m4_per_c2", c.electrostriction.q_m4_per_c2);
+    m->finish();
+  }
   if (auto m = p.optional_map("stress")) {
     m->read("enabled", c.stress.enabled);
     m->read("d_coefficient_per_pa", c.stress.d_coefficient_per_pa);

@@ -279,6 +279,12 @@ INSTANTIATE_TEST_SUITE_P(
              stress_coupling,
              {{"stress_dependence", "S"}, {"stress_dependence", "D"}}},
         Case{"permittivity_nonlinearity", permittivity, {{"permittivity_nonlinearity", "D"}}},
+        Case{"electrostriction",
+             [](plant::PlantConfig& p, plant::ExcitationConfig&) {
+               p.electrostriction.enabled = true;
+               p.electrostriction.q_m4_per_c2 = 0.02;
+             },
+             {{"electrostriction", "S"}}},
         Case{"leakage_and_creep",
              [](plant::PlantConfig& p, plant::ExcitationConfig& x) {
                leakage(p, x);

@@ -103,16 +103,71 @@ TEST(ChannelCorrection, StateSavedAndRestoredContinuesBitIdentically) {
   for (std::size_t k = 0; k < 500; ++k)
     static_cast<void>(sim.step(data.e[k], data.t[k]));
   ASSERT_TRUE(sim.save_state(state));
-  std::vector<double> first;
+  std::vector<Simulation::Output> first;
   for (std::size_t k = 500; k < 1000; ++k)
-    first.push_back(sim.step(data.e[k], data.t[k]).strain);
+    first.push_back(sim.step(data.e[k], data.t[k]));
   ASSERT_EQ(sim.restore_state(state), RestoreResult::kOk);
   for (std::size_t k = 500; k < 1000; ++k) {
-    EXPECT_EQ(sim.step(data.e[k], data.t[k]).strain, first[k - 500]) << k;
+    const Simulation::Output again = sim.step(data.e[k], data.t[k]);
+    EXPECT_EQ(again.strain, first[k - 500].strain) << k;
+    EXPECT_EQ(again.sensed, first[k - 500].sensed) << k;
   }
   // A model without the corrections is another model.
   Simulation plain(test::typical_transducer(kTs));
   EXPECT_EQ(plain.restore_state(state), RestoreResult::kWrongModel);
+}
+
+// The reconstruction's own state (leakage inverse, the drive's delay line) is saved too.
+TEST(ChannelCorrection, ReconstructionStateSavedAndRestoredContinuesBitIdentically) {
+  const TransducerModel m = corrected_model();
+  const test::TransducerData data = test::transducer_data(m, 1000, kTs, 6);
+  Simulation sim(m);
+  std::vector<double> d;
+  for (std::size_t k = 0; k < data.e.size(); ++k)
+    d.push_back(sim.step(data.e[k], data.t[k]).sensed);
+  Reconstruction rec(m);
+  SavedState state = rec.make_saved_state();
+  for (std::size_t k = 0; k < 500; ++k)
+    static_cast<void>(rec.step(data.e[k], d[k]));
+  ASSERT_TRUE(rec.save_state(state));
+  std::vector<Reconstruction::Estimate> first;
+  for (std::size_t k = 500; k < 1000; ++k)
+    first.push_back(rec.step(data.e[k], d[k]));
+  for (std::size_t k = 0; k < 37; ++k)
+    static_cast<void>(rec.step(data.e[k], d[k]));  // disturb
+  ASSERT_EQ(rec.restore_state(state), RestoreResult::kOk);
+  for (std::size_t k = 500; k < 1000; ++k) {
+    const Reconstruction::Estimate again = rec.step(data.e[k], d[k]);
+    EXPECT_EQ(again.stress, first[k - 500].stress) << k;
+    EXPECT_EQ(again.strain, first[k - 500].strain) << k;
+  }
+}
+
+// D = h + d T + q T^2 (a coupling that changes with stress): the reconstruction solves the
+// quadratic and recovers T, and S_hat follows.
+TEST(ChannelCorrection, StressQuadraticIsSolvedInTheReconstruction) {
+  TransducerModel m = test::typical_transducer(kTs);
+  ChannelCorrection c;
+  c.stress_quadratic_per_pa2 = 4e-9 * m.sensor->linear_gains.front();  // d k, k = 4e-9 / Pa
+  m.sensed_correction = c;
+  const test::TransducerData data = test::transducer_data(m, 3000, kTs, 8);
+  Simulation sim(m);
+  Reconstruction rec(m);
+  TransducerModel plain = m;
+  plain.sensed_correction.reset();
+  Reconstruction ignorant(plain);
+  double worst = 0.0;
+  double worst_ignorant = 0.0;
+  double range = 0.0;
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    const double d = sim.step(data.e[k], data.t[k]).sensed;
+    worst = std::max(worst, std::abs(rec.step(data.e[k], d).stress - data.t[k]));
+    worst_ignorant =
+        std::max(worst_ignorant, std::abs(ignorant.step(data.e[k], d).stress - data.t[k]));
+    range = std::max(range, std::abs(data.t[k]));
+  }
+  EXPECT_LT(worst, 1e-6 * range);
+  EXPECT_GT(worst_ignorant, 100.0 * worst);  // the term matters: without it T_hat is off
 }
 
 TEST(ChannelCorrection, ModelFileRoundTripKeepsEveryTermAndTheIdentity) {

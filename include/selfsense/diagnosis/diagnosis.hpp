@@ -40,6 +40,7 @@ struct Signals {
 
 struct Options {
   double min_explains{0.3};       // share of held-out residual variance an effect must remove
+  double min_share{0.02};         // ... and at least this share of the channel's first residual
   double alternative_share{0.8};  // alternatives: explain at least this share of the best's
   // A simpler candidate wins when the residual it leaves is at most this factor of the best's.
   double parsimony_ratio{1.25};

@@ -66,6 +66,7 @@ struct ChannelCorrection {
   // Closed-form inverse exists (header comment); otherwise *why names the term.
   [[nodiscard]] bool invertible(const std::string& prefix, std::string* why) const;
   [[nodiscard]] bool empty() const noexcept;
+  friend bool operator==(const ChannelCorrection&, const ChannelCorrection&) = default;
 };
 
 inline constexpr std::size_t kMaxCorrectionDelaySamples{64};
@@ -98,6 +99,7 @@ class CorrectionStage {
   // The drive delayed by this channel's delay (reconstruction feeds it to the kernel).
   double delay_drive(double drive) noexcept;
 
+  [[nodiscard]] const ChannelCorrection& correction() const noexcept { return c_; }
   [[nodiscard]] static constexpr std::size_t state_size() noexcept { return kStateSize; }
   void save_state(std::span<double> out) const noexcept;
   void restore_state(std::span<const double> in) noexcept;
@@ -107,7 +109,8 @@ class CorrectionStage {
   static constexpr std::size_t kStateSize = 12 + kMaxCorrectionCreep + 2 * kLine;
 
   double terms(const Inputs& in) const noexcept;  // the additive/gain terms except creep
-  double filters(double v) noexcept;              // dynamics, leakage, delay
+  double gain_at(const Inputs& in) const noexcept;
+  double filters(double v) noexcept;  // dynamics, leakage, delay
   double delayed(double value) noexcept;
 
   ChannelCorrection c_;

@@ -28,8 +28,10 @@
 //
 // Corrections a diagnosis added (channel_correction.hpp) run after the kernel: forward on both
 // channels in Simulation; in Reconstruction the sensed channel's correction is inverted before
-// the kernel (its delay moves to the drive) and the strain correction runs forward on S_hat.
-// Their state follows the kernel's in a SavedState; a hot swap starts them afresh. The
+// the kernel (its delay moves to the drive) and the strain correction runs forward on S_hat
+// (without its delay: a late bench sensor of S is not the actuator's). Their state follows the
+// kernel's in a SavedState; a hot swap carries it over when the correction is the same and
+// starts it afresh otherwise. The
 // temperature they may use is set with set_temperature() (default: their reference).
 //
 // Real-time safe after construction: step(), save_state(), restore_state(), adopt_state() are

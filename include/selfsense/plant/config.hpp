@@ -73,6 +73,14 @@ struct PermittivityConfig {
   double reference_field_v_per_m{2.0e6};
 };
 
+// Electrostriction: the strain follows the square of the polarization,
+//   S += q * P^2,   P = eps E + d_amplitude (p - p0)   [C/m^2] (the stress-free polarization),
+// so bipolar drive past the coercive field draws butterfly loops; q in m^4/C^2 (PZT: ~0.02).
+struct ElectrostrictionConfig {
+  bool enabled{false};
+  double q_m4_per_c2{0.02};
+};
+
 // d(T) = d * (1 + d_coefficient * T), hysteresis amplitudes * (1 + hysteresis_coefficient * T),
 // eps(T) = eps * (1 + permittivity_coefficient * T); T in Pa (compression < 0), the stack stress
 // of the same sample (Plant::step solves for it). Large compression therefore shrinks the
@@ -180,6 +188,7 @@ struct PlantConfig {
   HysteresisConfig hysteresis{};
   CreepConfig creep{};
   PermittivityConfig permittivity{};
+  ElectrostrictionConfig electrostriction{};
   StressConfig stress{};
   TemperatureConfig temperature{};
   MechanicsConfig mechanics{};
