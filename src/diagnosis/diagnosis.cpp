@@ -464,8 +464,13 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
     for (const Candidate& c : candidates()) {
       if (std::find(used.begin(), used.end(), &c) != used.end()) continue;
       if (!applicable(c, ch, s, !cs.sensed.empty(), charge_drive)) continue;
-      const identification::CorrectionFit local =
-          identification::fit_correction(on_current, c.terms, ChannelCorrection{}, in_segment);
+      identification::CorrectionFit local;
+      try {
+        local =
+            identification::fit_correction(on_current, c.terms, ChannelCorrection{}, in_segment);
+      } catch (const std::invalid_argument&) {
+        continue;  // no finite fit in this stretch
+      }
       const double after = segment_sse(ch.recorded, local.output, seg);
       const double bic = seg_n * std::log(std::max(after, 1e-300) / before) +
                          static_cast<double>(complexity(c.terms)) * std::log(seg_n);
@@ -484,8 +489,12 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
       start.dynamics_damping = best_found.dynamics_damping;
     }
     const std::vector<CorrectionTerm> terms = merged(accepted_terms, best->terms);
-    identification::CorrectionFit joint =
-        identification::fit_correction(cs, terms, start, rows.fit);
+    identification::CorrectionFit joint;
+    try {
+      joint = identification::fit_correction(cs, terms, start, rows.fit);
+    } catch (const std::invalid_argument&) {
+      continue;
+    }
     const double held_before = sse_over(ch.recorded, current, rows.judge);
     const double held_after = sse_over(ch.recorded, joint.output, rows.judge);
     const double seg_after = segment_sse(ch.recorded, joint.output, seg);
@@ -602,26 +611,30 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         if (!applicable(c, ch, s, has_sensor, !field)) continue;
         const std::vector<CorrectionTerm> terms = merged(accepted_terms, c.terms);
         ChannelCorrection start = accepted;
-        if (searches_filter(c, accepted) && !accepted_terms.empty()) {
-          // Search the new filter's parameters on what the accepted terms leave (few columns),
-          // then refit every coefficient jointly with the filters fixed.
-          identification::CorrectionSignals on_current = cs;
-          on_current.y = current;
-          const ChannelCorrection found =
-              identification::fit_correction(on_current, c.terms, ChannelCorrection{}, fit_rows)
-                  .correction;
-          start.leakage_tau_s = std::max(start.leakage_tau_s, found.leakage_tau_s);
-          start.delay_s = std::max(start.delay_s, found.delay_s);
-          if (start.dynamics_frequency_hz == 0.0) {
-            start.dynamics_frequency_hz = found.dynamics_frequency_hz;
-            start.dynamics_damping = found.dynamics_damping;
+        try {
+          if (searches_filter(c, accepted) && !accepted_terms.empty()) {
+            // Search the new filter's parameters on what the accepted terms leave (few columns),
+            // then refit every coefficient jointly with the filters fixed.
+            identification::CorrectionSignals on_current = cs;
+            on_current.y = current;
+            const ChannelCorrection found =
+                identification::fit_correction(on_current, c.terms, ChannelCorrection{}, fit_rows)
+                    .correction;
+            start.leakage_tau_s = std::max(start.leakage_tau_s, found.leakage_tau_s);
+            start.delay_s = std::max(start.delay_s, found.delay_s);
+            if (start.dynamics_frequency_hz == 0.0) {
+              start.dynamics_frequency_hz = found.dynamics_frequency_hz;
+              start.dynamics_damping = found.dynamics_damping;
+            }
           }
+          identification::CorrectionFit fit =
+              identification::fit_correction(cs, terms, start, fit_rows);
+          const double sse = sse_over(ch.recorded, fit.output, rows.judge);
+          const double typical = median_block_explains(ch.recorded, current, fit.output, rows);
+          tried.push_back({&c, std::move(fit), 1.0 - sse / current_sse, typical});
+        } catch (const std::invalid_argument&) {
+          continue;  // no finite fit of this candidate on these signals: not a candidate here
         }
-        identification::CorrectionFit fit =
-            identification::fit_correction(cs, terms, start, fit_rows);
-        const double sse = sse_over(ch.recorded, fit.output, rows.judge);
-        const double typical = median_block_explains(ch.recorded, current, fit.output, rows);
-        tried.push_back({&c, std::move(fit), 1.0 - sse / current_sse, typical});
       }
       if (tried.empty()) break;
       std::sort(tried.begin(), tried.end(),
