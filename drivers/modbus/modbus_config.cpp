@@ -2,17 +2,13 @@
 
 #include <cmath>
 
+#include "selfsense/operators/parameter_error.hpp"
+
 namespace selfsense::drivers::modbus {
 namespace {
 
 std::string number(double x) {
-  std::string s = std::to_string(x);
-  while (s.find('.') != std::string::npos && (s.back() == '0' || s.back() == '.')) {
-    const bool dot = s.back() == '.';
-    s.pop_back();
-    if (dot) break;
-  }
-  return s;
+  return operators::format_number(x);
 }
 
 }  // namespace

@@ -150,13 +150,20 @@ double CorrectionStage::terms(const Inputs& in) const noexcept {
          c_.sensed_quadratic * in.sensed * in.sensed;
 }
 
-double CorrectionStage::delayed(double value) noexcept {
-  head_ = (head_ + 1) % kLine;
-  line_[head_] = value;
+// Writes `value` into a ring and reads it back the configured delay later (linear interpolation
+// between the two samples around it).
+double CorrectionStage::push_delayed(std::array<double, kLine>& line, std::size_t& head,
+                                     double value) const noexcept {
+  head = (head + 1) % kLine;
+  line[head] = value;
   if (!delay_) return value;
-  const double a = line_[(head_ + kLine - delay_whole_) % kLine];
-  const double b = line_[(head_ + kLine - delay_whole_ - 1) % kLine];
+  const double a = line[(head + kLine - delay_whole_) % kLine];
+  const double b = line[(head + kLine - delay_whole_ - 1) % kLine];
   return a + delay_frac_ * (b - a);
+}
+
+double CorrectionStage::delayed(double value) noexcept {
+  return push_delayed(line_, head_, value);
 }
 
 double CorrectionStage::filters(double v) noexcept {
@@ -204,12 +211,7 @@ double CorrectionStage::delay_drive(double drive) noexcept {
     drive_started_ = true;
     drive_line_.fill(drive);
   }
-  drive_head_ = (drive_head_ + 1) % kLine;
-  drive_line_[drive_head_] = drive;
-  if (!delay_) return drive;
-  const double a = drive_line_[(drive_head_ + kLine - delay_whole_) % kLine];
-  const double b = drive_line_[(drive_head_ + kLine - delay_whole_ - 1) % kLine];
-  return a + delay_frac_ * (b - a);
+  return push_delayed(drive_line_, drive_head_, drive);
 }
 
 double CorrectionStage::invert(double measured, const Inputs& in) noexcept {

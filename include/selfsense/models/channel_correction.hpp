@@ -112,6 +112,8 @@ class CorrectionStage {
   double gain_at(const Inputs& in) const noexcept;
   double filters(double v) noexcept;  // dynamics, leakage, delay
   double delayed(double value) noexcept;
+  double push_delayed(std::array<double, kLine>& line, std::size_t& head,
+                      double value) const noexcept;
 
   ChannelCorrection c_;
   std::array<double, kMaxCorrectionCreep> alpha_{};  // 1 - exp(-lambda Ts)
