@@ -75,16 +75,18 @@ run_tests() {
   ctest --test-dir "$dir" --output-on-failure -j "$jobs" "$@"
 }
 
-# Self-sensing on the simulated transducer: record identification and validation data from
-# the plant, identify the hysteresis-creep model, reconstruct T and S from E and D alone.
+# Self-sensing on the simulated transducer: record an identification recording (the mix, then
+# minor loops of many sizes and offsets) and a validation recording under excitation the fit
+# never saw, identify the Preisach-class model, reconstruct T and S from E and D alone.
 run_self_sensing() {
   local out=build/demo cli=build/src/cli/selfsense cfg=config/plant/reconstruction.yaml
   mkdir -p "$out"
-  say "main job: plant recordings ($cfg)"
-  "$cli" plant --config "$cfg" --excitation mix --seed 1 --out "$out/identification.csv"
-  "$cli" plant --config "$cfg" --excitation mix --seed 2 --out "$out/validation.csv"
-  say "main job: identify the hysteresis-creep model, validate on the second recording"
-  "$cli" identify --recording "$out/identification.csv" --structure hysteresis-creep \
+  say "main job: plant recordings ($cfg, config/plant/reconstruction-validation.yaml)"
+  "$cli" plant --config "$cfg" --excitation identification --seed 1 --out "$out/identification.csv"
+  "$cli" plant --config config/plant/reconstruction-validation.yaml --excitation mix --seed 2 \
+    --out "$out/validation.csv"
+  say "main job: identify the preisach-creep model, validate on new excitation"
+  "$cli" identify --recording "$out/identification.csv" --structure preisach-creep \
     --holdout 0 --validate "$out/validation.csv" --out "$out/model.yaml" --json "$out/fit.json"
   say "main job: self-sensing reconstruction of T and S from E and D"
   "$cli" reconstruct --model "$out/model.yaml" --recording "$out/validation.csv" \

@@ -181,8 +181,10 @@ void add_plant_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--seed", opt->seed, "overrides plant.seed");
-  cmd->add_option("--excitation", opt->excitation,
-                  "steps | sines | decaying | noise | mix | csv:PATH (E, optional F_ext and temp)")
+  cmd->add_option(
+         "--excitation", opt->excitation,
+         "steps | sines | decaying | noise | loops | mix | identification (mix, then loops) | "
+         "csv:PATH (E, optional F_ext and temp)")
       ->required();
   cmd->add_option("--out", opt->out, "recording to write (CSV)")->required();
   cmd->add_flag("--realtime", opt->realtime,

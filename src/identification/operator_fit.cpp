@@ -206,6 +206,7 @@ class Fitter {
     Bounds b;
     b.add(basis_.plays(), true, floor_);
     b.add(basis_.creep(), true, 0.0);
+    b.add(basis_.hinges(), false, 0.0);
     if (with_extras) b.add(extras(), false, 0.0);
     return b;
   }
@@ -375,6 +376,20 @@ OperatorBasis basis_for(const OperatorSignals& signals, const OperatorStructure&
       basis.creep_rows.push_back(k * (structure.plays + 1) / (extra + 1));
     }
   }
+  // After a full sweep the play of threshold r moves within [lo + r, hi - r]: the hinges
+  // split that span evenly (plays that hardly move get none).
+  const double x_lo = *std::min_element(signals.input.begin(), signals.input.end());
+  for (std::size_t i = 0; i < basis.thresholds.size() && structure.bias_levels > 0; ++i) {
+    const double r = basis.thresholds[i];
+    const double span = x_range - 2.0 * r;
+    if (span < 0.1 * x_range) continue;
+    for (std::size_t k = 1; k <= structure.bias_levels; ++k) {
+      basis.hinge_rows.push_back(i);
+      basis.hinge_levels.push_back(x_lo + r +
+                                   span * static_cast<double>(k) /
+                                       static_cast<double>(structure.bias_levels + 1));
+    }
+  }
   return basis;
 }
 
@@ -395,6 +410,8 @@ std::vector<double> estimate_history(const OperatorSignals& signals, const Opera
   // rows of [sweep, head) are accumulated once; the lags still remember the start there, which
   // the shared rows ignore (it only blurs the score).
   OperatorBasis scoring = basis;
+  scoring.hinge_rows.clear();  // the start shows in the plays; hinges only refine their output
+  scoring.hinge_levels.clear();
   if (!creep_lags) {
     scoring.creep_rows.clear();
   } else if (scoring.creep_rows.size() > 1) {
@@ -506,6 +523,25 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
     }
   }
   Fit fit = fit_with_history(fitter, history, structure, n);
+  if (basis.hinges() > 0 && structure.dead_zones > 0) {
+    // The dead-zone stage is not convex: the equation-error start with hinges can land in a
+    // worse optimum than the fit without them. That fit, with zero hinge weights, is in this
+    // class; refined from there it competes, so hinges never fit the data worse.
+    OperatorBasis plain = basis;
+    plain.hinge_rows.clear();
+    plain.hinge_levels.clear();
+    Fitter plain_fitter(signals, plain, weight_floor, structure.fit_offset);
+    Fit candidate = fit_with_history(plain_fitter, history, structure, n);
+    candidate.theta.conservativeResize(static_cast<Eigen::Index>(basis.columns()));
+    candidate.theta.tail(static_cast<Eigen::Index>(basis.hinges())).setZero();
+    if (candidate.rss < fit.rss) fit = candidate;
+    for (std::size_t pass = 0; pass < structure.refinement_passes; ++pass) {
+      candidate = fitter.refit_operator(candidate);
+      if (candidate.rss < fit.rss) fit = candidate;
+      candidate = fitter.refit_shape(candidate);
+      if (candidate.rss < fit.rss) fit = candidate;
+    }
+  }
   if (search && structure.dead_zones > 0 && DeadZoneSuperposition(fit.shape).size() > 0) {
     // The first search scored the start with S = identity; when the data need dead zones its
     // model error outweighs the start's signature and a richer basis could pick a worse start
@@ -542,6 +578,13 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
     creep.thresholds.push_back(basis.thresholds[r]);
   for (std::size_t c = 0; c < basis.creep(); ++c) {
     creep.weights.push_back(std::max(0.0, fit.theta(static_cast<Eigen::Index>(basis.plays() + c))));
+  }
+  auto& hinges = model.op.hinges;
+  for (std::size_t g = 0; g < basis.hinges(); ++g) {
+    hinges.thresholds.push_back(basis.thresholds[basis.hinge_rows[g]]);
+    hinges.levels.push_back(basis.hinge_levels[g]);
+    hinges.weights.push_back(
+        fit.theta(static_cast<Eigen::Index>(basis.plays() + basis.creep() + g)));
   }
   return model;
 }

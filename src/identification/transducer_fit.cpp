@@ -1,6 +1,7 @@
 #include "selfsense/identification/transducer_fit.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -19,7 +20,38 @@ OperatorStructure structure_of(const IdentificationOptions& o, bool creep) {
   s.estimate_history = o.estimate_history;
   s.fastest_eigenvalue = o.fastest_eigenvalue;
   s.slowest_eigenvalue = o.slowest_eigenvalue;
+  s.bias_levels = o.bias_levels;
   return s;
+}
+
+// The number of hinges per play whose fit on the first three quarters of the data predicts
+// the last quarter best (the operator runs on from the start, so its memory is the fit's).
+std::size_t chosen_bias_levels(const OperatorSignals& s, OperatorStructure structure) {
+  const std::size_t n = s.input.size();
+  const std::size_t split = n - n / 4;
+  OperatorSignals head{s.input.first(split), {}, s.output.first(split), s.sample_time};
+  for (const auto& u : s.linear_inputs)
+    head.linear_inputs.push_back(u.first(split));
+  std::vector<double> y(n);
+  std::size_t best = 0;
+  double best_rss = std::numeric_limits<double>::infinity();
+  for (const std::size_t levels : kBiasLevelCandidates) {
+    structure.bias_levels = levels;
+    simulate_operator(fit_operator(head, structure), s.input, s.linear_inputs, y);
+    double rss = 0.0;
+    for (std::size_t k = split; k < n; ++k)
+      rss += (y[k] - s.output[k]) * (y[k] - s.output[k]);
+    if (rss < best_rss) {
+      best_rss = rss;
+      best = levels;
+    }
+  }
+  return best;
+}
+
+OperatorModel fit_side(const OperatorSignals& s, OperatorStructure structure, bool choose) {
+  if (choose && s.input.size() >= 8) structure.bias_levels = chosen_bias_levels(s, structure);
+  return fit_operator(s, structure);
 }
 
 models::InputRange range_of(std::span<const double> x) {
@@ -40,6 +72,8 @@ IdentificationOptions defaults_for(Structure s) noexcept {
       return {24, 0, 0, 8, true, 0.0, 0.0};
     case Structure::kHysteresisCreep:
       return {24, 6, 2, 8, true, 0.0, 0.0};
+    case Structure::kPreisachCreep:
+      return {24, 6, 2, 8, true, 0.0, 0.0, 0, true};
     case Structure::kStressHysteresis:
       return {16, 0, 0, 0, false, 0.0, 0.0};
   }
@@ -73,10 +107,12 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
   std::vector<std::span<const double>> linear;
   if (!signals.stress.empty()) linear.push_back(signals.stress);
 
-  const bool creep = structure == Structure::kHysteresisCreep;
+  const bool creep =
+      structure == Structure::kHysteresisCreep || structure == Structure::kPreisachCreep;
+  const bool choose = structure == Structure::kPreisachCreep && options.choose_bias_levels;
   if (usable(signals.sensed)) {
-    model.sensor = fit_operator({signals.drive, linear, signals.sensed, signals.sample_time},
-                                structure_of(options, creep));
+    model.sensor = fit_side({signals.drive, linear, signals.sensed, signals.sample_time},
+                            structure_of(options, creep), choose);
   }
   if (usable(signals.strain)) {
     // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19);
@@ -92,8 +128,9 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
         squared[k] = signals.drive[k] * signals.drive[k];
       inputs.emplace_back(squared);
     }
-    model.actuator = fit_operator({signals.drive, inputs, signals.strain, signals.sample_time},
-                                  linear_side ? OperatorStructure{} : structure_of(options, creep));
+    model.actuator = fit_side({signals.drive, inputs, signals.strain, signals.sample_time},
+                              linear_side ? OperatorStructure{} : structure_of(options, creep),
+                              choose && !linear_side);
     if (!squared.empty()) {
       model.actuator->quadratic = model.actuator->linear_gains.back();
       model.actuator->linear_gains.pop_back();

@@ -58,6 +58,13 @@ HysteresisCreep::Params read_operator(YamlMap& side) {
     c->finish();
     validate(side, p.creep, "ThresholdCreep.", "creep");
   }
+  if (auto g = side.optional_map("hinges")) {
+    g->read_sequence("thresholds", p.hinges.thresholds);
+    g->read_sequence("levels", p.hinges.levels);
+    g->read_sequence("weights", p.hinges.weights);
+    g->finish();
+    validate(side, p.hinges, "PlayHinges.", "hinges");
+  }
   return p;
 }
 
@@ -230,6 +237,13 @@ void emit_side(YAML::Emitter& out, const char* key, const SideModel& side) {
   emit_sequence(out, "eigenvalues", c.eigenvalues);
   emit_sequence(out, "weights", c.weights);
   out << YAML::EndMap;
+  if (const auto& g = side.op.hinges; !g.empty()) {
+    out << YAML::Key << "hinges" << YAML::Value << YAML::BeginMap;
+    emit_sequence(out, "thresholds", g.thresholds);
+    emit_sequence(out, "levels", g.levels);
+    emit_sequence(out, "weights", g.weights);
+    out << YAML::EndMap;
+  }
   out << YAML::EndMap;
 }
 

@@ -44,6 +44,11 @@ void add_side(Fnv1a& h, const std::optional<SideModel>& side) noexcept {
   h.add(op.creep.thresholds);
   h.add(op.creep.eigenvalues);
   h.add(op.creep.weights);
+  if (!op.hinges.empty()) {  // models without hinges keep the identity they had
+    h.add(op.hinges.thresholds);
+    h.add(op.hinges.levels);
+    h.add(op.hinges.weights);
+  }
   h.add(side->linear_gains);
   h.add(side->offset);
   h.add(side->quadratic);

@@ -10,12 +10,13 @@
 namespace selfsense::models {
 namespace {
 
-constexpr std::array<std::pair<Structure, std::string_view>, 6> kNames{{
+constexpr std::array<std::pair<Structure, std::string_view>, 7> kNames{{
     {Structure::kLinear, "linear"},
     {Structure::kPermittivity, "permittivity"},
     {Structure::kChargeDrive, "charge-drive"},
     {Structure::kHysteresis, "hysteresis"},
     {Structure::kHysteresisCreep, "hysteresis-creep"},
+    {Structure::kPreisachCreep, "preisach-creep"},
     {Structure::kStressHysteresis, "stress-hysteresis"},
 }};
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "selfsense/operators/kernels.hpp"
@@ -26,7 +27,7 @@ bool HysteresisCreep::Params::is_valid(std::string* why) const {
   };
   return prefixed("hysteresis", hysteresis.is_valid(why)) &&
          prefixed("superposition", superposition.is_valid(why)) &&
-         prefixed("creep", creep.is_valid(why));
+         prefixed("creep", creep.is_valid(why)) && prefixed("hinges", hinges.is_valid(why));
 }
 
 HysteresisCreep::Params HysteresisCreep::with_nonlinear_creep(
@@ -50,7 +51,13 @@ HysteresisCreep::HysteresisCreep(Params params, double sample_time)
   thresholds_.push_back(0.0);
   std::set_union(h.thresholds.begin(), h.thresholds.end(), c.thresholds.begin(), c.thresholds.end(),
                  std::back_inserter(thresholds_));
+  thresholds_.insert(thresholds_.end(), params_.hinges.thresholds.begin(),
+                     params_.hinges.thresholds.end());
+  std::sort(thresholds_.begin(), thresholds_.end());
   thresholds_.erase(std::unique(thresholds_.begin(), thresholds_.end()), thresholds_.end());
+  for (const double r : params_.hinges.thresholds)
+    hinge_rows_.push_back(index_in(thresholds_, r));
+  scale_ = std::max(thresholds_.back(), 1e-300);
   const std::size_t n = thresholds_.size();
   hysteresis_weights_.assign(n, 0.0);
   hysteresis_weights_[0] = h.linear_weight;
@@ -81,11 +88,19 @@ HysteresisCreep::HysteresisCreep(Params params, double sample_time)
   state_.assign(n + creep_weights_.size(), 0.0);
 }
 
+double HysteresisCreep::hinge_sum(std::span<const double> plays) const noexcept {
+  double sum = 0.0;
+  const PlayHinges& g = params_.hinges;
+  for (std::size_t h = 0; h < hinge_rows_.size(); ++h)
+    sum += g.weights[h] * std::max(plays[hinge_rows_[h]] - g.levels[h], 0.0);
+  return sum;
+}
+
 double HysteresisCreep::inner_step(double x) noexcept {
   const std::span<double> p = plays();
   const std::span<double> z = lags();
   kernels::play_bank_step(x, thresholds_, p);
-  double sum = kernels::dot(hysteresis_weights_, p);
+  double sum = kernels::dot(hysteresis_weights_, p) + hinge_sum(p);
   const std::size_t cols = params_.creep.eigenvalues.size();
   for (std::size_t i = 0; i < creep_rows_.size(); ++i) {
     const std::size_t e = i * cols;
@@ -108,9 +123,76 @@ void HysteresisCreep::apply(std::span<const double> x, std::span<double> y) noex
 double HysteresisCreep::input_for(double y) noexcept {
   const double carry = kernels::dot(carry_weights_, lags());
   const double target = shape_inverse_.evaluate(y) - carry;
+  if (!hinge_rows_.empty()) return solve_inner(target);
   PrandtlIshlinskii::inverse_state(effective_weights_, plays(), scratch_);
   kernels::play_bank_step(target, inverse_thresholds_, scratch_);
   return kernels::dot(inverse_weights_, scratch_);
+}
+
+// sum_i (w_i + b_i) p_i(x) + hinges(p(x)) with p_i(x) = clamp(p_i, x - r_i, x + r_i): the
+// creep-free part of this sample's H + K (the carry is the rest). A play moves with x (slope
+// 1) where the clamp binds, else it holds.
+double HysteresisCreep::trial_inner(double x, double* slope) const noexcept {
+  const std::span<const double> p = std::span<const double>(state_).first(play_count());
+  const auto moved = [&](std::size_t i) {
+    return std::min(std::max(p[i], x - thresholds_[i]), x + thresholds_[i]);
+  };
+  const auto moving = [&](std::size_t i, double now) {
+    return now != p[i] || thresholds_[i] == 0.0;
+  };
+  double value = 0.0;
+  double rate = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double now = moved(i);
+    value += effective_weights_[i] * now;
+    if (moving(i, now)) rate += effective_weights_[i];
+  }
+  const PlayHinges& g = params_.hinges;
+  for (std::size_t h = 0; h < hinge_rows_.size(); ++h) {
+    const std::size_t i = hinge_rows_[h];
+    const double now = moved(i);
+    if (now > g.levels[h]) {
+      value += g.weights[h] * (now - g.levels[h]);
+      if (moving(i, now)) rate += g.weights[h];
+    }
+  }
+  *slope = rate;
+  return value;
+}
+
+double HysteresisCreep::solve_inner(double target) const noexcept {
+  if (!std::isfinite(target)) return target;
+  // Start where the input is now: the answer is near it for any sample-to-sample change.
+  double x = state_[0];
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  double step = scale_;
+  constexpr int kIterations = 100;
+  for (int it = 0; it < kIterations; ++it) {
+    double slope = 0.0;
+    const double miss = trial_inner(x, &slope) - target;
+    if (miss == 0.0) return x;
+    if (miss < 0.0) {
+      lo = x;
+    } else {
+      hi = x;
+    }
+    const bool bracketed = std::isfinite(lo) && std::isfinite(hi);
+    if (bracketed && hi - lo <= 1e-12 * std::max(std::abs(lo), std::abs(hi))) break;
+    double next = slope > 0.0 ? x - miss / slope : std::numeric_limits<double>::quiet_NaN();
+    // On the root's linear piece Newton lands on the root; what is left is rounding.
+    if (std::abs(next - x) <= 1e-12 * std::max(std::abs(x), scale_)) return next;
+    if (!(next > lo && next < hi)) {
+      if (bracketed) {
+        next = 0.5 * (lo + hi);
+      } else {  // no bracket yet: walk outwards, doubling
+        next = miss < 0.0 ? x + step : x - step;
+        step *= 2.0;
+      }
+    }
+    x = next;
+  }
+  return std::isfinite(lo) && std::isfinite(hi) ? 0.5 * (lo + hi) : x;
 }
 
 double HysteresisCreep::inverse_step(double y) noexcept {
@@ -128,6 +210,7 @@ void HysteresisCreep::apply_inverse(std::span<const double> y, std::span<double>
 double HysteresisCreep::output() const noexcept {
   const std::span<const double> all(state_);
   return shape_.evaluate(kernels::dot(hysteresis_weights_, all.first(play_count())) +
+                         hinge_sum(all.first(play_count())) +
                          kernels::dot(creep_weights_, all.subspan(play_count())));
 }
 

@@ -38,6 +38,8 @@ std::span<const double> RegressorStream::next(double x) noexcept {
       row_[c++] = z;
     }
   }
+  for (std::size_t h = 0; h < b.hinge_rows.size(); ++h)
+    row_[c++] = std::max(plays_[b.hinge_rows[h]] - b.hinge_levels[h], 0.0);
   return row_;
 }
 

@@ -1,10 +1,12 @@
 #include "selfsense/plant/excitation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 
 #include "checker.hpp"
 #include "selfsense/plant/random.hpp"
@@ -70,6 +72,17 @@ bool ExcitationConfig::is_valid(std::string* why) const {
   c.finite("noise.min_v_per_m", noise.min_v_per_m);
   c.require(std::isfinite(noise.max_v_per_m) && noise.max_v_per_m > noise.min_v_per_m,
             "noise.max_v_per_m", noise.max_v_per_m, "must be above noise.min_v_per_m");
+  c.positive("loops.duration_s", loops.duration_s);
+  c.finite("loops.min_v_per_m", loops.min_v_per_m);
+  c.require(std::isfinite(loops.max_v_per_m) && loops.max_v_per_m > loops.min_v_per_m,
+            "loops.max_v_per_m", loops.max_v_per_m, "must be above loops.min_v_per_m");
+  c.positive("loops.rate_min_v_per_m_s", loops.rate_min_v_per_m_s);
+  c.require(std::isfinite(loops.rate_max_v_per_m_s) &&
+                loops.rate_max_v_per_m_s >= loops.rate_min_v_per_m_s,
+            "loops.rate_max_v_per_m_s", loops.rate_max_v_per_m_s,
+            "must be at least loops.rate_min_v_per_m_s");
+  c.require(std::isfinite(loops.hold_max_s) && loops.hold_max_s >= 0.0, "loops.hold_max_s",
+            loops.hold_max_s, "must be a finite number >= 0");
   c.finite("load.offset_n", load.offset_n);
   c.finite("load.amplitude_n", load.amplitude_n);
   c.positive("load.frequency_hz", load.frequency_hz);
@@ -145,6 +158,31 @@ std::vector<double> make_noise(const NoiseConfig& config, double sample_rate_hz,
   return out;
 }
 
+std::vector<double> make_loops(const LoopsConfig& config, double sample_rate_hz,
+                               std::uint64_t seed) {
+  const std::size_t n = samples(config.duration_s, sample_rate_hz);
+  Random random{seed ^ 0x5851F42D4C957F2DULL};
+  std::vector<double> out;
+  out.reserve(n);
+  double level = config.min_v_per_m;
+  bool rising = true;
+  while (out.size() < n) {
+    const double limit = rising ? config.max_v_per_m : config.min_v_per_m;
+    const double u = random.uniform();
+    const double next = level + (limit - level) * u * u;
+    const double rate = config.rate_min_v_per_m_s +
+                        (config.rate_max_v_per_m_s - config.rate_min_v_per_m_s) * random.uniform();
+    ramp(out, level, next, std::abs(next - level) / rate, sample_rate_hz);
+    if (random.uniform() < 1.0 / 3.0) {
+      out.insert(out.end(), samples(config.hold_max_s * random.uniform(), sample_rate_hz), next);
+    }
+    level = next;
+    rising = !rising;
+  }
+  out.resize(n);
+  return out;
+}
+
 void apply_load_and_temperature(const ExcitationConfig& config, double sample_rate_hz,
                                 Excitation& excitation) {
   const std::size_t n = excitation.size();
@@ -163,18 +201,24 @@ void apply_load_and_temperature(const ExcitationConfig& config, double sample_ra
 
 Excitation make_excitation(const std::string& kind, const ExcitationConfig& config,
                            double sample_rate_hz, std::uint64_t seed) {
+  constexpr std::array<std::string_view, 7> kKinds{"steps", "sines", "decaying",      "noise",
+                                                   "loops", "mix",   "identification"};
+  if (std::find(kKinds.begin(), kKinds.end(), kind) == kKinds.end()) {
+    throw std::invalid_argument{
+        "unknown excitation '" + kind +
+        "' (steps, sines, decaying, noise, loops, mix, identification or csv:PATH)"};
+  }
   Excitation ex{};
   auto append = [&ex](const std::vector<double>& part) {
     ex.e_v_per_m.insert(ex.e_v_per_m.end(), part.begin(), part.end());
   };
-  if (kind == "steps" || kind == "mix") append(make_steps(config.steps, sample_rate_hz));
-  if (kind == "sines" || kind == "mix") append(make_sines(config.sines, sample_rate_hz));
-  if (kind == "decaying" || kind == "mix") append(make_decaying(config.decaying, sample_rate_hz));
-  if (kind == "noise" || kind == "mix") append(make_noise(config.noise, sample_rate_hz, seed));
-  if (kind != "steps" && kind != "sines" && kind != "decaying" && kind != "noise" &&
-      kind != "mix") {
-    throw std::invalid_argument{"unknown excitation '" + kind +
-                                "' (steps, sines, decaying, noise, mix or csv:PATH)"};
+  const bool mix = kind == "mix" || kind == "identification";
+  if (kind == "steps" || mix) append(make_steps(config.steps, sample_rate_hz));
+  if (kind == "sines" || mix) append(make_sines(config.sines, sample_rate_hz));
+  if (kind == "decaying" || mix) append(make_decaying(config.decaying, sample_rate_hz));
+  if (kind == "noise" || mix) append(make_noise(config.noise, sample_rate_hz, seed));
+  if (kind == "loops" || kind == "identification") {
+    append(make_loops(config.loops, sample_rate_hz, seed));
   }
   apply_load_and_temperature(config, sample_rate_hz, ex);
   return ex;

@@ -193,6 +193,15 @@ void read_excitation(YamlMap x, ExcitationConfig& c) {
     m->read("max_v_per_m", c.noise.max_v_per_m);
     m->finish();
   }
+  if (auto m = x.optional_map("loops")) {
+    m->read("duration_s", c.loops.duration_s);
+    m->read("min_v_per_m", c.loops.min_v_per_m);
+    m->read("max_v_per_m", c.loops.max_v_per_m);
+    m->read("rate_min_v_per_m_s", c.loops.rate_min_v_per_m_s);
+    m->read("rate_max_v_per_m_s", c.loops.rate_max_v_per_m_s);
+    m->read("hold_max_s", c.loops.hold_max_s);
+    m->finish();
+  }
   if (auto m = x.optional_map("load")) {
     m->read("offset_n", c.load.offset_n);
     m->read("amplitude_n", c.load.amplitude_n);

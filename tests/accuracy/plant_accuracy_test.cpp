@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <vector>
 
 #include "selfsense/identification/fit_quality.hpp"
@@ -40,10 +41,14 @@ Recorded record(const plant::PlantConfig& config, const plant::Excitation& ex) {
   return r;
 }
 
-Recorded record_mix(std::uint64_t seed) {
+Recorded record_kind(const char* kind, std::uint64_t seed) {
   plant::PlantFile f = benchmark_plant();
   f.plant.seed = seed;
-  return record(f.plant, plant::make_excitation("mix", f.excitation, f.plant.sample_rate_hz, seed));
+  return record(f.plant, plant::make_excitation(kind, f.excitation, f.plant.sample_rate_hz, seed));
+}
+
+Recorded record_mix(std::uint64_t seed) {
+  return record_kind("mix", seed);
 }
 
 models::TransducerModel identify(const Recorded& r, models::Structure structure) {
@@ -82,6 +87,52 @@ const Identified& identified() {
   return models;
 }
 
+// The identification excitation (mix, then minor loops of many sizes and offsets), seed 1.
+struct IdentifiedOnLoops {
+  models::TransducerModel preisach_creep;
+  models::TransducerModel hysteresis_creep;
+};
+
+const IdentifiedOnLoops& identified_on_loops() {
+  static const IdentifiedOnLoops models = [] {
+    const Recorded r = record_kind("identification", 1);
+    return IdentifiedOnLoops{identify(r, models::Structure::kPreisachCreep),
+                             identify(r, models::Structure::kHysteresisCreep)};
+  }();
+  return models;
+}
+
+// A validation excitation generated anew: step levels, sine amplitudes and frequencies, the
+// decaying sine, the noise band and the load drawn from `seed` (none equals the fitting
+// recording's), inside the field range the fit saw (0 .. 2 MV/m).
+Recorded record_new_excitation(std::uint64_t seed) {
+  plant::PlantFile f = benchmark_plant();
+  std::mt19937_64 rng(seed);
+  const auto uniform = [&rng](double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng);
+  };
+  plant::ExcitationConfig& x = f.excitation;
+  x.steps.levels_v_per_m.clear();
+  for (int i = 0; i < 6; ++i)
+    x.steps.levels_v_per_m.push_back(uniform(0.1e6, 1.95e6));
+  x.steps.hold_s = uniform(4.0, 8.0);
+  x.sines.offset_v_per_m = uniform(0.9e6, 1.1e6);
+  x.sines.amplitudes_v_per_m = {uniform(0.15e6, 0.5e6), uniform(0.5e6, 0.85e6)};
+  x.sines.frequencies_hz = {uniform(0.3, 1.2), uniform(1.5, 4.0)};
+  x.decaying.amplitude_v_per_m = uniform(0.6e6, 0.85e6);
+  x.decaying.offset_v_per_m = uniform(0.95e6, 1.1e6);
+  x.decaying.frequency_hz = uniform(0.5, 2.0);
+  x.decaying.decay_per_cycle = uniform(0.85, 0.95);
+  x.noise.cutoff_hz = uniform(1.0, 5.0);
+  x.noise.offset_v_per_m = uniform(0.8e6, 1.2e6);
+  x.noise.std_v_per_m = uniform(0.25e6, 0.45e6);
+  x.noise.duration_s = 30.0;
+  x.load.amplitude_n = uniform(200.0, 450.0);
+  x.load.frequency_hz = uniform(0.05, 0.3);
+  f.plant.seed = seed;
+  return record(f.plant, plant::make_excitation("mix", x, f.plant.sample_rate_hz, seed));
+}
+
 TEST(PlantAccuracy, SelfSensingOnAHeldOutRecordingMeetsTheGoals) {
   const Recorded validation = record_mix(2);  // other noise: not used to fit anything
   const Figures hc = reconstruct(identified().hysteresis_creep, validation);
@@ -95,6 +146,42 @@ TEST(PlantAccuracy, SelfSensingOnAHeldOutRecordingMeetsTheGoals) {
   // The linear model on the same data is far worse.
   EXPECT_GT(lin.strain.nrmse, 5.0 * hc.strain.nrmse);
   EXPECT_GT(lin.stress.nrmse, 5.0 * hc.stress.nrmse);
+}
+
+// Excitation the fit never saw, the worst of three drawn validations, for the structure whose
+// hinges per play were chosen on the fitting recording alone (transducer_fit.hpp), against
+// hysteresis-creep identified on the same recording. Issue 7's goal (S_hat <= 0.3 % RMS and
+// 1.5 % max, T_hat <= 1.5 %) is open: met on these three, not on the main job's validation
+// (docs/results.md). Asserted: the measured worst figures with a margin, and the improvement.
+TEST(PlantAccuracy, PreisachClassImprovesSelfSensingOnNewExcitation) {
+  Figures worst_pc{};
+  Figures worst_hc{};
+  const auto worst = [](Figures& w, const Figures& f) {
+    w.strain.nrmse = std::max(w.strain.nrmse, f.strain.nrmse);
+    w.strain.max = std::max(w.strain.max, f.strain.max);
+    w.stress.nrmse = std::max(w.stress.nrmse, f.stress.nrmse);
+    w.stress.max = std::max(w.stress.max, f.stress.max);
+  };
+  const IdentifiedOnLoops& m = identified_on_loops();
+  for (const std::uint64_t seed : {11U, 12U, 13U}) {
+    const Recorded validation = record_new_excitation(seed);
+    const Figures pc = reconstruct(m.preisach_creep, validation);
+    const Figures hc = reconstruct(m.hysteresis_creep, validation);
+    std::printf(
+        "seed %llu: preisach-creep S_hat %.3f %% (max %.3f %%), T_hat %.3f %%; "
+        "hysteresis-creep S_hat %.3f %% (max %.3f %%), T_hat %.3f %%\n",
+        static_cast<unsigned long long>(seed), 100 * pc.strain.nrmse, 100 * pc.strain.max,
+        100 * pc.stress.nrmse, 100 * hc.strain.nrmse, 100 * hc.strain.max, 100 * hc.stress.nrmse);
+    worst(worst_pc, pc);
+    worst(worst_hc, hc);
+  }
+  RecordProperty("worst_S_hat_nrmse", std::to_string(worst_pc.strain.nrmse));
+  RecordProperty("worst_T_hat_nrmse", std::to_string(worst_pc.stress.nrmse));
+  EXPECT_LE(worst_pc.strain.nrmse, 0.0032);
+  EXPECT_LE(worst_pc.strain.max, 0.015);
+  EXPECT_LE(worst_pc.stress.nrmse, 0.012);
+  EXPECT_LE(worst_pc.strain.nrmse, 0.8 * worst_hc.strain.nrmse);
+  EXPECT_LE(worst_pc.stress.nrmse, 0.8 * worst_hc.stress.nrmse);
 }
 
 // Open-loop tracking of a strain trajectory that was not in the identification data, with the

@@ -81,18 +81,50 @@ void BM_HysteresisCreepInverse(benchmark::State& state) {
 BENCHMARK(BM_HysteresisCreepInverse);
 
 // The reconstruction workload of one control cycle: the sensor-side operator (E -> D), the
-// actuator-side operator (E -> S) and the inverse compensator (desired S -> E).
-void BM_ReconstructionWorkload(benchmark::State& state) {
+// actuator-side operator (E -> S) and the inverse compensator (desired S -> E). Arguments:
+// creep elements on plays besides r = 0, and hinges per play (the preisach-creep structure;
+// its inverse is solved numerically).
+struct Workload {
+  HysteresisCreep sensor;
+  HysteresisCreep actuator;
+  HysteresisCreepCompensator feedforward;
+};
+
+HysteresisCreep::Params hinged(HysteresisCreep::Params p, std::size_t per_play) {
+  std::vector<double> r{0.0};
+  r.insert(r.end(), p.hysteresis.thresholds.begin(), p.hysteresis.thresholds.end());
+  for (const double threshold : r) {
+    for (std::size_t k = 1; k <= per_play; ++k) {
+      p.hinges.thresholds.push_back(threshold);
+      p.hinges.levels.push_back(threshold + (2e6 - 2.0 * threshold) * static_cast<double>(k) /
+                                                static_cast<double>(per_play + 1));
+      p.hinges.weights.push_back(0.05 * p.hysteresis.linear_weight / static_cast<double>(k));
+    }
+  }
+  return p;
+}
+
+Workload workload(const benchmark::State& state) {
   TypicalStackSize size = workload_size();
   size.creep_plays = static_cast<std::size_t>(state.range(0));
-  HysteresisCreep sensor(typical_stack_charge(size), kTs);
-  HysteresisCreep actuator(typical_stack_strain(size), kTs);
-  HysteresisCreepCompensator feedforward(HysteresisCreep(typical_stack_strain(size), kTs), 0.0,
-                                         2e6);
-  run(state,
-      [&](double x) { return sensor.step(x) + actuator.step(x) + feedforward.step(x * 6e-10); });
+  const auto hinges = static_cast<std::size_t>(state.range(1));
+  const HysteresisCreep::Params strain = hinged(typical_stack_strain(size), hinges);
+  return {HysteresisCreep(hinged(typical_stack_charge(size), hinges), kTs),
+          HysteresisCreep(strain, kTs),
+          HysteresisCreepCompensator(HysteresisCreep(strain, kTs), 0.0, 2e6)};
 }
-BENCHMARK(BM_ReconstructionWorkload)->Arg(0)->Arg(4)->ArgName("creep_plays");
+
+void BM_ReconstructionWorkload(benchmark::State& state) {
+  Workload w = workload(state);
+  run(state, [&](double x) {
+    return w.sensor.step(x) + w.actuator.step(x) + w.feedforward.step(x * 6e-10);
+  });
+}
+BENCHMARK(BM_ReconstructionWorkload)
+    ->Args({0, 0})
+    ->Args({4, 0})
+    ->Args({0, 3})
+    ->ArgNames({"creep_plays", "hinges_per_play"});
 
 // Tail latency: every one of kTimedSamples samples timed on its own with steady_clock, so the
 // worst cases show (cache misses, interrupts, preemption on a shared core), not only the mean.
@@ -143,20 +175,16 @@ void run_timed(benchmark::State& state, Step step) {
 }
 
 void BM_ReconstructionWorkloadTail(benchmark::State& state) {
-  TypicalStackSize size = workload_size();
-  size.creep_plays = static_cast<std::size_t>(state.range(0));
-  HysteresisCreep sensor(typical_stack_charge(size), kTs);
-  HysteresisCreep actuator(typical_stack_strain(size), kTs);
-  HysteresisCreepCompensator feedforward(HysteresisCreep(typical_stack_strain(size), kTs), 0.0,
-                                         2e6);
+  Workload w = workload(state);
   run_timed(state, [&](double x) {
-    return sensor.step(x) + actuator.step(x) + feedforward.step(x * 6e-10);
+    return w.sensor.step(x) + w.actuator.step(x) + w.feedforward.step(x * 6e-10);
   });
 }
 BENCHMARK(BM_ReconstructionWorkloadTail)
-    ->Arg(0)
-    ->Arg(4)
-    ->ArgName("creep_plays")
+    ->Args({0, 0})
+    ->Args({4, 0})
+    ->Args({0, 3})
+    ->ArgNames({"creep_plays", "hinges_per_play"})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond);
 

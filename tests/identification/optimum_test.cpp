@@ -157,8 +157,10 @@ Series run_reference(const Reference& ref, const test::OperatorRecording& r) {
 
 models::TransducerModel library_fit(const test::OperatorRecording& r, std::size_t plays,
                                     std::size_t dead_zones, std::size_t eigenvalues,
-                                    std::size_t creep_plays, std::size_t fit_to) {
+                                    std::size_t creep_plays, std::size_t fit_to,
+                                    std::size_t bias_levels = 0) {
   identification::IdentificationOptions o;
+  o.bias_levels = bias_levels;
   o.plays = plays;
   o.dead_zones = dead_zones;
   o.eigenvalues = eigenvalues;
@@ -244,24 +246,28 @@ TEST(IdentificationOptimum, HeldOutTailWithCreepStaysAtTheOptimum) {
 TEST(IdentificationOptimum, RicherBasesNeverFitTheFittingDataWorse) {
   const Recordings& r = cached(true, 1.0);
   struct Size {
-    std::size_t plays, dead_zones, eigenvalues;
+    std::size_t plays, dead_zones, eigenvalues, bias_levels{0};
   };
-  // Each one adds to the one before.
+  // Each one adds to the one before (hinge levels at k / (K + 1) of a play's span nest for
+  // K = 1, 3, 7).
   const std::vector<std::vector<Size>> chains{
       {{16, 8, 6}, {24, 8, 6}, {48, 8, 6}},
       {{24, 0, 6}, {24, 4, 6}, {24, 8, 6}},
       {{24, 8, 0}, {24, 8, 6}},
+      {{24, 0, 6, 0}, {24, 0, 6, 1}, {24, 0, 6, 3}},
+      {{24, 8, 6, 0}, {24, 8, 6, 1}, {24, 8, 6, 3}},
   };
   for (const auto& chain : chains) {
     Figures previous{1.0, 1.0, 1.0, 1.0};
     for (const Size& size : chain) {
       const models::TransducerModel m =
           library_fit(r.fit, size.plays, size.dead_zones, size.eigenvalues,
-                      size.eigenvalues > 0 ? kCreepPlays : 0, kFitSamples);
+                      size.eigenvalues > 0 ? kCreepPlays : 0, kFitSamples, size.bias_levels);
       const Figures f = figures(r.fit, run_model(m, r.fit), 0);
       const std::string label = std::to_string(size.plays) + " plays " +
                                 std::to_string(size.dead_zones) + " dz " +
-                                std::to_string(size.eigenvalues) + " eig, fit";
+                                std::to_string(size.eigenvalues) + " eig " +
+                                std::to_string(size.bias_levels) + " bias, fit";
       print(label.c_str(), f);
       EXPECT_LE(f.d, previous.d * (1.0 + 1e-3)) << label;
       EXPECT_LE(f.s, previous.s * (1.0 + 1e-3)) << label;

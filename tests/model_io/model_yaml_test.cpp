@@ -46,6 +46,27 @@ TEST(ModelYaml, RoundTripIsBitIdentical) {
   EXPECT_EQ(back.structure, Structure::kHysteresisCreep);
 }
 
+TEST(ModelYaml, HingesRoundTripAndAreValidatedByKey) {
+  TransducerModel m = test::typical_transducer(1e-4);
+  m.structure = Structure::kPreisachCreep;
+  m.sensor->op.hinges = {{0.0, 2e5}, {1.0e6, 0.8e6}, {1e-9, -2e-10}};
+  const std::string text = model_to_string(m, "");
+  const TransducerModel back = model_from_string(text);
+  EXPECT_EQ(model_to_string(back, ""), text);
+  EXPECT_EQ(back.structure, Structure::kPreisachCreep);
+  EXPECT_EQ(back.sensor->op.hinges.levels, m.sensor->op.hinges.levels);
+  EXPECT_EQ(back.sensor->op.hinges.weights, m.sensor->op.hinges.weights);
+  EXPECT_TRUE(back.actuator->op.hinges.empty());
+  expect_error(kMinimal +
+                   "  hinges:\n    thresholds: [-1.0]\n    levels: [0.0]\n"
+                   "    weights: [1.0]\n",
+               "sensor.hinges.thresholds[0]");
+  expect_error(kMinimal +
+                   "  hinges:\n    thresholds: [1.0]\n    levels: [0.0, 1.0]\n"
+                   "    weights: [1.0]\n",
+               "sensor.hinges.levels");
+}
+
 TEST(ModelYaml, VectorialModelRoundTrips) {
   const test::TransducerData d = test::transducer_data(test::typical_transducer(1e-3), 3000, 0, 4);
   TransducerModel m;

@@ -109,6 +109,62 @@ TEST(HysteresisCreep, TypicalStackHasRealisticHysteresisAndCreep) {
   EXPECT_LT(stroke, 1.8e-3);
 }
 
+// The typical charge operator with hinges on three of its plays (and the input): a Preisach
+// operator whose density grows towards high bias.
+HysteresisCreep::Params with_hinges() {
+  HysteresisCreep::Params p = typical_stack_charge(with_creep_plays());
+  const double w0 = p.hysteresis.linear_weight;
+  const std::vector<double>& r = p.hysteresis.thresholds;
+  p.hinges.thresholds = {0.0, r[2], r[2], r[8], r[15]};
+  p.hinges.levels = {1.2e6, 0.6e6, 1.3e6, 1.0e6, 1.1e6};
+  p.hinges.weights = {0.3 * w0, 0.2 * w0, -0.1 * w0, 0.15 * w0, 0.1 * w0};
+  return p;
+}
+
+TEST(HysteresisCreep, HingesAddAPiecewiseLinearFunctionOfTheirPlays) {
+  HysteresisCreep::Params p = with_hinges();
+  p.superposition = {};  // S = identity: the output is H + K itself
+  HysteresisCreep::Params plain = p;
+  plain.hinges = {};
+  HysteresisCreep op(p, kTs);
+  HysteresisCreep pi(plain, kTs);
+  // Plays of the hinges' thresholds, stepped alongside: max(x - r, min(x + r, p)).
+  std::vector<double> plays(p.hinges.thresholds.size(), 0.0);
+  for (const double v : test::random_walk(20000, 0.0, 2e6, 2e4, 5)) {
+    double expected = pi.step(v);
+    for (std::size_t h = 0; h < plays.size(); ++h) {
+      const double r = p.hinges.thresholds[h];
+      plays[h] = std::min(std::max(plays[h], v - r), v + r);
+      expected += p.hinges.weights[h] * std::max(plays[h] - p.hinges.levels[h], 0.0);
+    }
+    ASSERT_NEAR(op.step(v), expected, 1e-12 * std::abs(expected) + 1e-18);
+    ASSERT_NEAR(op.output(), expected, 1e-12 * std::abs(expected) + 1e-18);
+  }
+}
+
+TEST(HysteresisCreep, InverseWithHingesRecoversTheInput) {
+  HysteresisCreep op(with_hinges(), kTs);
+  HysteresisCreep twin(with_hinges(), kTs);
+  for (const double v : test::random_walk(20000, 0.0, 2e6, 2e4, 23)) {
+    const double target = twin.step(v);
+    const double x = op.inverse_step(target);
+    ASSERT_NEAR(x, v, 1e-6 * 2e6);
+    ASSERT_NEAR(op.output(), target, 1e-9 * std::abs(target) + 1e-15);
+  }
+}
+
+TEST(HysteresisCreep, CompensatorWithHingesFollowsLargeSteps) {
+  HysteresisCreepCompensator feedforward(HysteresisCreep(with_hinges(), kTs), -1e7, 1e7);
+  HysteresisCreep actuator(with_hinges(), kTs);
+  HysteresisCreep reference(with_hinges(), kTs);
+  // Reachable targets with jumps of up to the whole range between samples.
+  for (const double v : {0.0, 2e6, 0.1e6, 1.7e6, 0.9e6, 1.0e6, 0.0, 1.95e6}) {
+    const double yd = reference.step(v);
+    ASSERT_NEAR(actuator.step(feedforward.step(yd)), yd, 1e-9 * std::abs(yd));
+  }
+  EXPECT_EQ(feedforward.saturation_count(), 0U);
+}
+
 TEST(HysteresisCreep, StateSaveAndRestore) {
   HysteresisCreep op(typical_stack_strain(with_creep_plays()), kTs);
   const std::vector<double> e = test::random_walk(4000, 0.0, 2e6, 3e4, 17);

@@ -2,13 +2,16 @@
 // and dissipates energy around its D-E loop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "plant_test_util.hpp"
 #include "selfsense/io/yaml_map.hpp"
+#include "selfsense/plant/excitation.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
 
 namespace selfsense::plant {
@@ -94,6 +97,44 @@ TEST(ExcitationConfig, NonFiniteValuesNameTheirKeys) {
   EXPECT_NE(why.find("excitation.noise.min_v_per_m"), std::string::npos) << why;
 }
 
+TEST(ExcitationConfig, LoopsTurnInsideTheirRangeAtManySizesAndOffsets) {
+  LoopsConfig c{};
+  c.duration_s = 60.0;
+  const std::vector<double> e = make_loops(c, 1000.0, 7);
+  ASSERT_EQ(e.size(), 60000U);
+  std::vector<double> turns;
+  for (std::size_t k = 1; k + 1 < e.size(); ++k) {
+    ASSERT_GE(e[k], c.min_v_per_m);
+    ASSERT_LE(e[k], c.max_v_per_m);
+    const double in = e[k] - e[k - 1];
+    const double out = e[k + 1] - e[k];
+    if (in * out < 0.0) turns.push_back(e[k]);
+  }
+  // Many reversals, at low, middle and high field, of small and large size.
+  ASSERT_GT(turns.size(), 40U);
+  const auto count_if = [&](auto pred) { return std::count_if(turns.begin(), turns.end(), pred); };
+  EXPECT_GT(count_if([](double v) { return v < 0.6e6; }), 3);
+  EXPECT_GT(count_if([](double v) { return v > 0.7e6 && v < 1.3e6; }), 3);
+  EXPECT_GT(count_if([](double v) { return v > 1.4e6; }), 3);
+  std::size_t small = 0;
+  std::size_t large = 0;
+  for (std::size_t i = 1; i < turns.size(); ++i) {
+    const double size = std::abs(turns[i] - turns[i - 1]);
+    small += size < 0.2e6 ? 1U : 0U;
+    large += size > 0.8e6 ? 1U : 0U;
+  }
+  EXPECT_GT(small, 3U);
+  EXPECT_GT(large, 3U);
+  // Seeded: the same seed, the same field.
+  EXPECT_EQ(make_loops(c, 1000.0, 7), e);
+  c.rate_max_v_per_m_s = 0.1e6;
+  std::string why;
+  ExcitationConfig x{};
+  x.loops = c;
+  EXPECT_FALSE(x.is_valid(&why));
+  EXPECT_NE(why.find("excitation.loops.rate_max_v_per_m_s"), std::string::npos) << why;
+}
+
 TEST(PlantYaml, UnknownKeyNamesPathAndLine) {
   const std::string msg = load_error("plant:\n  creep:\n    enabled: true\n    tua_s: [1]\n");
   EXPECT_EQ(msg, "P.yaml:4: plant.creep.tua_s: unknown key");
@@ -140,7 +181,7 @@ TEST(PlantYaml, ReadsEveryValueIntoTheStructs) {
       "plant:\n  seed: 42\n  creep: {enabled: true, tau_s: [1, 2], s_weights: [0.1, 0.2],"
       " d_weights: [0, 0]}\n  sensors: {d: {adc: {enabled: true, bits: 12}}}\n"
       "  faults:\n    - {kind: stuck_adc, channel: e, start_s: 0.5, duration_s: 0.1}\n"
-      "excitation:\n  temperature: {end_degc: 60}\n");
+      "excitation:\n  temperature: {end_degc: 60}\n  loops: {duration_s: 12, hold_max_s: 0.5}\n");
   EXPECT_EQ(f.plant.seed, 42U);
   EXPECT_TRUE(f.plant.creep.enabled);
   EXPECT_EQ(f.plant.creep.tau_s, (std::vector<double>{1.0, 2.0}));
@@ -150,6 +191,8 @@ TEST(PlantYaml, ReadsEveryValueIntoTheStructs) {
   EXPECT_EQ(f.plant.faults[0].kind, FaultKind::stuck_adc);
   EXPECT_EQ(f.plant.faults[0].channel, Channel::e);
   EXPECT_DOUBLE_EQ(f.excitation.temperature.end_degc, 60.0);
+  EXPECT_DOUBLE_EQ(f.excitation.loops.duration_s, 12.0);
+  EXPECT_DOUBLE_EQ(f.excitation.loops.hold_max_s, 0.5);
 }
 
 // Energy sanity: for every example configuration the cyclic integral of E dD over the closed

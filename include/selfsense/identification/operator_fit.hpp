@@ -2,7 +2,8 @@
 //
 //   y = S[ H[x] + K[x] ] + sum_k g_k u_k + offset
 //
-// H: PI operator (linear term + `plays` plays), K: creep elements (eigenvalues x creep
+// H: PI operator (linear term + `plays` plays), with bias_levels hinges on each play a
+// Preisach operator (operators/play_hinges.hpp), K: creep elements (eigenvalues x creep
 // thresholds), S: dead-zone superposition, u_k: inputs that enter linearly (stress T for the
 // paper's eq. 26-27). Every transducer structure is a special case: no plays, no creep and no
 // dead zones is the linear model (5-6); dead zones alone a stored characteristic (9-13); x = D
@@ -10,7 +11,8 @@
 //
 // The fit is convex and deterministic (no random restarts):
 //  1. weights enter linearly; with the partial sums W_i = w_0 + ... + w_i as unknowns the
-//     invertibility condition W_i > 0 is a simple bound, creep weights are >= 0: a bounded
+//     invertibility condition W_i > 0 is a simple bound, creep weights are >= 0 (hinge weights
+//     are free): a bounded
 //     least-squares problem on the normal equations (solve_bounded_least_squares);
 //  2. with dead zones, the inverse superposition S' = S^-1 is fitted in the same way on the
 //     equation error S'[y - g u - offset] = H[x] + K[x] (Kuhnen's modified-PI identification),
@@ -35,10 +37,13 @@
 namespace selfsense::identification {
 
 struct OperatorStructure {
-  std::size_t plays{0};            // play operators besides the linear term
-  std::size_t eigenvalues{0};      // creep lags; 0: no creep
-  std::size_t creep_plays{0};      // creep elements on plays besides r = 0
-  std::size_t dead_zones{0};       // per side of the superposition; 0: S = identity
+  std::size_t plays{0};        // play operators besides the linear term
+  std::size_t eigenvalues{0};  // creep lags; 0: no creep
+  std::size_t creep_plays{0};  // creep elements on plays besides r = 0
+  std::size_t dead_zones{0};   // per side of the superposition; 0: S = identity
+  // Hinges per play (play_hinges.hpp: the Preisach class) at levels spread evenly over the
+  // play's output range; 0: a PI operator.
+  std::size_t bias_levels{0};
   double fastest_eigenvalue{0.0};  // [1/s]; 0: min(100, 0.1 / Ts)
   double slowest_eigenvalue{0.0};  // [1/s]; 0: 3 / duration
   bool estimate_history{true};     // false: start demagnetised at the first input

@@ -3,6 +3,7 @@
 // the stress-dependent model by fit_stress_hysteresis. Not real-time code.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <span>
 
@@ -22,7 +23,12 @@ struct IdentificationOptions {
   bool estimate_history{true};
   double fastest_eigenvalue{0.0};  // [1/s]; 0: from the sample time (OperatorStructure)
   double slowest_eigenvalue{0.0};  // [1/s]; 0: from the duration
+  std::size_t bias_levels{0};      // hinges per play (OperatorStructure::bias_levels)
+  // preisach-creep: choose bias_levels among kBiasLevelCandidates per side, by the output
+  // error on the last quarter of the fitting data of a fit on the first three quarters.
+  bool choose_bias_levels{false};
 };
+inline constexpr std::array<std::size_t, 3> kBiasLevelCandidates{0, 1, 3};
 [[nodiscard]] IdentificationOptions defaults_for(Structure s) noexcept;
 
 // Recorded signals in field quantities. drive is E (field drive) or D (charge drive), sensed

@@ -14,6 +14,8 @@
 //   permittivity      sensor G = piecewise linear eps(E) * E   (eq. 9-13), actuator linear
 //   hysteresis        G = modified PI                          (eq. 14-15)
 //   hysteresis-creep  G = modified PI + creep                  (eq. 26-31)
+//   preisach-creep    G = modified PI with hinges on its plays + creep: the Preisach class
+//                     (operators/play_hinges.hpp), minor loops that change with their offset
 //   charge-drive      sensor E = modified PI of D, actuator S linear in D (eq. 18-19)
 //   stress-hysteresis coupling, permittivity and loop size depend on T (section 3.3, the
 //                     vectorial case): StressHysteresisModel, reconstructed numerically
@@ -39,6 +41,7 @@ enum class Structure {
   kPermittivity,
   kHysteresis,
   kHysteresisCreep,
+  kPreisachCreep,
   kChargeDrive,
   kStressHysteresis
 };

@@ -2,11 +2,12 @@
 //
 //   Gamma[x] = S[ H[x] + K[x] ]
 //   H[x] = sum_{i=0..n} w_i p_i            PI operator, p_0 = x, thresholds 0 = r_0 < ... < r_n
+//          + sum_h c_h max(0, p_{r_h} - b_h)  optional hinges (play_hinges.hpp): Preisach class
 //   K[x] = sum_{i,j} c_ij z_ij             creep elements: lag lambda_j on the play of threshold
 //                                          r_i (ThresholdCreep), c_ij >= 0
 //   S                                      dead-zone superposition (asymmetry, saturation)
 // The paper's K = L[H[x]] (eq. 28) is the rank-one case c_ij = w_i c_j (with_nonlinear_creep()).
-// H and K share one play bank: the union of their thresholds.
+// H and K share one play bank: the union of their thresholds (and the hinges').
 //
 // Inverse, one sample at a time (inverse_step). With a_j = 1 - exp(-lambda_j Ts) the lags give
 //   K[x][k] = sum_i b_i p_i[k] + sum_{i,j} c_ij (1 - a_j) z_ij[k-1],   b_i = sum_j c_ij a_j,
@@ -15,9 +16,15 @@
 //   v = S^-1[y],  x = H~^-1[v - carry],  H~ = PI(r, w + b),
 // all closed form; H~^-1 is evaluated from the current forward play states (no separate
 // inverse state that could drift). The weights keep H~ invertible because c_ij >= 0.
+// With hinges H~ is no longer a PI operator: the sample's output is still piecewise linear in
+// x (each play moves with x or holds, each hinge is on or off), so x is solved for by a
+// safeguarded Newton iteration on that function (bisection inside a bracket when Newton
+// leaves it), which lands exactly once it reaches the right piece; the root is unique while
+// H~ increases in x, and when hinges bend it back, a root next to the PI part's inverse is taken.
 //
-// step() and inverse_step() are real-time safe: O(n_plays + n_creep + n_deadzones), no
-// allocation, no exceptions.
+// step() and inverse_step() are real-time safe: O(n_plays + n_creep + n_deadzones + n_hinges)
+// (the inverse with hinges a bounded number of such evaluations), no allocation, no
+// exceptions.
 #pragma once
 
 #include <cstddef>
@@ -27,6 +34,7 @@
 
 #include "selfsense/operators/dead_zone_superposition.hpp"
 #include "selfsense/operators/linear_creep.hpp"
+#include "selfsense/operators/play_hinges.hpp"
 #include "selfsense/operators/prandtl_ishlinskii.hpp"
 #include "selfsense/operators/threshold_creep.hpp"
 
@@ -38,6 +46,7 @@ class HysteresisCreep final {
     PrandtlIshlinskii::Params hysteresis{};
     DeadZoneSuperposition::Params superposition{};  // default: identity
     ThresholdCreep::Params creep{};                 // default: no creep
+    PlayHinges hinges{};                            // default: none (a PI operator)
 
     [[nodiscard]] bool is_valid(std::string* why) const;
   };
@@ -84,6 +93,10 @@ class HysteresisCreep final {
     return std::span(state_).subspan(play_count());
   }
   [[nodiscard]] double inner_step(double x) noexcept;  // H[x] + K[x], advancing the state
+  [[nodiscard]] double hinge_sum(std::span<const double> plays) const noexcept;
+  // H~ at input x from the current state, and its slope in x there, without advancing.
+  [[nodiscard]] double trial_inner(double x, double* slope) const noexcept;
+  [[nodiscard]] double solve_inner(double target) const noexcept;  // H~[x] = target
 
   Params params_{};
   double sample_time_{0.0};
@@ -99,6 +112,8 @@ class HysteresisCreep final {
   std::vector<double> inverse_weights_{};     // w' of H~^-1
   std::vector<double> effective_weights_{};   // w + b
   std::vector<double> scratch_{};             // inverse play states, sized once
+  std::vector<std::size_t> hinge_rows_{};     // play index of each hinge
+  double scale_{1.0};                         // input scale of the inverse's first step
   std::vector<double> state_{};               // plays, then lags
 };
 

@@ -4,7 +4,8 @@
 //
 // Operator columns, per sample: q_i = p_i - p_{i+1} (p_{n+1} = 0) for the PI partial sums W_i,
 // so that H[x] = sum_i W_i q_i, then the creep lags z_rj for c_rj, discretised exactly:
-//   z[k] = z[k-1] + a_j (p_r[k] - z[k-1]),   a_j = 1 - exp(-lambda_j Ts).
+//   z[k] = z[k-1] + a_j (p_r[k] - z[k-1]),   a_j = 1 - exp(-lambda_j Ts),
+// then the hinges max(0, p_r[k] - b_h) for c_h (play_hinges.hpp).
 // RegressorStream::next() and the state copies are real-time safe (no allocation, no throw).
 #pragma once
 
@@ -18,13 +19,16 @@ struct OperatorBasis {
   std::vector<double> thresholds{};  // r_0 = 0 first; creep thresholds are a subset
   std::vector<std::size_t> creep_rows{};
   std::vector<double> eigenvalues{};
-  std::vector<double> gains{};  // a_j = 1 - exp(-lambda_j Ts)
+  std::vector<double> gains{};            // a_j = 1 - exp(-lambda_j Ts)
+  std::vector<std::size_t> hinge_rows{};  // play index of each hinge
+  std::vector<double> hinge_levels{};     // b_h
 
   [[nodiscard]] std::size_t plays() const noexcept { return thresholds.size(); }
   [[nodiscard]] std::size_t creep() const noexcept {
     return creep_rows.size() * eigenvalues.size();
   }
-  [[nodiscard]] std::size_t columns() const noexcept { return plays() + creep(); }
+  [[nodiscard]] std::size_t hinges() const noexcept { return hinge_rows.size(); }
+  [[nodiscard]] std::size_t columns() const noexcept { return plays() + creep() + hinges(); }
 };
 
 // Operator columns of successive samples, from the state after `history` with settled creep.

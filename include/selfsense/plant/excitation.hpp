@@ -49,6 +49,20 @@ struct NoiseConfig {
   double max_v_per_m{2.0e6};
 };
 
+// Minor loops of many sizes around many offsets, for identification: from min_v_per_m the
+// field turns at seeded random extrema in [min, max], alternately up and down (the next
+// extremum u^2 of the way to the limit, u uniform, so small loops are frequent and large
+// ones occur), ramping at a random rate in [rate_min, rate_max] and holding a random time of
+// up to hold_max_s at a third of the extrema (creep during holds).
+struct LoopsConfig {
+  double duration_s{60.0};
+  double min_v_per_m{0.0};
+  double max_v_per_m{2.0e6};
+  double rate_min_v_per_m_s{0.2e6};
+  double rate_max_v_per_m_s{4.0e6};
+  double hold_max_s{2.0};
+};
+
 // External force: offset + amplitude sin(2 pi f t) (N); 0 amplitude for a constant force.
 struct LoadConfig {
   double offset_n{0.0};
@@ -67,6 +81,7 @@ struct ExcitationConfig {
   SinesConfig sines{};
   DecayingConfig decaying{};
   NoiseConfig noise{};
+  LoopsConfig loops{};
   LoadConfig load{};
   TemperatureProfileConfig temperature{};
 
@@ -90,9 +105,12 @@ struct Excitation {
                                                 double sample_rate_hz);
 [[nodiscard]] std::vector<double> make_noise(const NoiseConfig& config, double sample_rate_hz,
                                              std::uint64_t seed);
+[[nodiscard]] std::vector<double> make_loops(const LoopsConfig& config, double sample_rate_hz,
+                                             std::uint64_t seed);
 
-// kind: steps | sines | decaying | noise | mix (all four in that order). Adds the load and the
-// temperature profile. Throws std::invalid_argument for an unknown kind.
+// kind: steps | sines | decaying | noise | loops | mix (the first four in that order) |
+// identification (mix, then loops: what an identification recording should cover). Adds the
+// load and the temperature profile. Throws std::invalid_argument for an unknown kind.
 [[nodiscard]] Excitation make_excitation(const std::string& kind, const ExcitationConfig& config,
                                          double sample_rate_hz, std::uint64_t seed);
 // Fills force and temperature of an excitation whose field is already set.
