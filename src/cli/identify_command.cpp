@@ -95,7 +95,10 @@ void run_identify(const IdentifyOptions& opt) {
   if (opt.plays >= 0) sizes.plays = static_cast<std::size_t>(opt.plays);
   if (opt.eigenvalues >= 0) sizes.eigenvalues = static_cast<std::size_t>(opt.eigenvalues);
   if (opt.creep_plays >= 0) sizes.creep_plays = static_cast<std::size_t>(opt.creep_plays);
-  if (opt.dead_zones >= 0) sizes.dead_zones = static_cast<std::size_t>(opt.dead_zones);
+  if (opt.dead_zones >= 0) {
+    sizes.dead_zones = static_cast<std::size_t>(opt.dead_zones);
+    sizes.choose_dead_zones = false;
+  }
   if (opt.bias_levels >= 0) {
     sizes.bias_levels = static_cast<std::size_t>(opt.bias_levels);
     sizes.choose_bias_levels = false;
@@ -202,7 +205,10 @@ void add_identify_command(CLI::App& app) {
   cmd->add_option("--eigenvalues", opt->eigenvalues, "Creep eigenvalues")->check(CLI::Range(0, 32));
   cmd->add_option("--creep-plays", opt->creep_plays, "Creep elements on plays besides r = 0")
       ->check(CLI::Range(0, 64));
-  cmd->add_option("--dead-zones", opt->dead_zones, "Dead zones per side")->check(CLI::Range(0, 64));
+  cmd->add_option("--dead-zones", opt->dead_zones,
+                  "Dead zones per side (preisach-creep chooses 0 or 8 on the fitting data unless "
+                  "given)")
+      ->check(CLI::Range(0, 64));
   cmd->add_option("--bias-levels", opt->bias_levels,
                   "Hinges per play (0: PI operator; preisach-creep chooses 0, 1 or 3 on the "
                   "fitting data unless given)")

@@ -1,7 +1,10 @@
 #include "selfsense/identification/transducer_fit.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -24,33 +27,65 @@ OperatorStructure structure_of(const IdentificationOptions& o, bool creep) {
   return s;
 }
 
-// The number of hinges per play whose fit on the first three quarters of the data predicts
-// the last quarter best (the operator runs on from the start, so its memory is the fit's).
-std::size_t chosen_bias_levels(const OperatorSignals& s, OperatorStructure structure) {
-  const std::size_t n = s.input.size();
-  const std::size_t split = n - n / 4;
-  OperatorSignals head{s.input.first(split), {}, s.output.first(split), s.sample_time};
-  for (const auto& u : s.linear_inputs)
-    head.linear_inputs.push_back(u.first(split));
-  std::vector<double> y(n);
-  std::size_t best = 0;
-  double best_rss = std::numeric_limits<double>::infinity();
-  for (const std::size_t levels : kBiasLevelCandidates) {
-    structure.bias_levels = levels;
-    simulate_operator(fit_operator(head, structure), s.input, s.linear_inputs, y);
+// Sizes chosen on the fitting data alone: each candidate is fitted on the first three quarters
+// and judged by its output error on the last quarter (the operator runs on from the start, so
+// its memory there is the fit's own). Dead zones first (none or the given number), then the
+// hinges per play with the dead zones chosen.
+class SizeChooser {
+ public:
+  explicit SizeChooser(const OperatorSignals& s)
+      : s_(s), split_(s.input.size() - s.input.size() / 4), y_(s.input.size()) {
+    head_ = {s.input.first(split_), {}, s.output.first(split_), s.sample_time};
+    for (const auto& u : s.linear_inputs)
+      head_.linear_inputs.push_back(u.first(split_));
+  }
+
+  [[nodiscard]] double tail_rss(const OperatorStructure& structure) {
+    simulate_operator(fit_operator(head_, structure), s_.input, s_.linear_inputs, y_);
     double rss = 0.0;
-    for (std::size_t k = split; k < n; ++k)
-      rss += (y[k] - s.output[k]) * (y[k] - s.output[k]);
-    if (rss < best_rss) {
-      best_rss = rss;
-      best = levels;
+    for (std::size_t k = split_; k < y_.size(); ++k)
+      rss += (y_[k] - s_.output[k]) * (y_[k] - s_.output[k]);
+    return std::isfinite(rss) ? rss : std::numeric_limits<double>::infinity();
+  }
+
+  // The candidate value of `field` with the smallest tail error (the first one on ties).
+  template <typename Field>
+  void choose(OperatorStructure& structure, Field OperatorStructure::*field,
+              std::span<const Field> candidates) {
+    Field best = structure.*field;
+    double best_rss = std::numeric_limits<double>::infinity();
+    for (const Field value : candidates) {
+      structure.*field = value;
+      const double rss = tail_rss(structure);
+      if (rss < best_rss) {
+        best_rss = rss;
+        best = value;
+      }
+    }
+    structure.*field = best;
+  }
+
+ private:
+  const OperatorSignals& s_;
+  std::size_t split_;
+  OperatorSignals head_{};
+  std::vector<double> y_;
+};
+
+OperatorModel fit_side(const OperatorSignals& s, OperatorStructure structure,
+                       const IdentificationOptions& options, bool choose) {
+  if (choose && s.input.size() >= 8) {
+    SizeChooser chooser(s);
+    if (options.choose_dead_zones && structure.dead_zones > 0) {
+      const std::array<std::size_t, 2> dead_zones{0, structure.dead_zones};
+      chooser.choose(structure, &OperatorStructure::dead_zones,
+                     std::span<const std::size_t>(dead_zones));
+    }
+    if (options.choose_bias_levels) {
+      chooser.choose(structure, &OperatorStructure::bias_levels,
+                     std::span<const std::size_t>(kBiasLevelCandidates));
     }
   }
-  return best;
-}
-
-OperatorModel fit_side(const OperatorSignals& s, OperatorStructure structure, bool choose) {
-  if (choose && s.input.size() >= 8) structure.bias_levels = chosen_bias_levels(s, structure);
   return fit_operator(s, structure);
 }
 
@@ -73,7 +108,7 @@ IdentificationOptions defaults_for(Structure s) noexcept {
     case Structure::kHysteresisCreep:
       return {24, 6, 2, 8, true, 0.0, 0.0};
     case Structure::kPreisachCreep:
-      return {24, 6, 2, 8, true, 0.0, 0.0, 0, true};
+      return {24, 6, 2, 8, true, 0.0, 0.0, 0, true, true};
     case Structure::kStressHysteresis:
       return {16, 0, 0, 0, false, 0.0, 0.0};
   }
@@ -109,10 +144,10 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
 
   const bool creep =
       structure == Structure::kHysteresisCreep || structure == Structure::kPreisachCreep;
-  const bool choose = structure == Structure::kPreisachCreep && options.choose_bias_levels;
+  const bool choose = structure == Structure::kPreisachCreep;
   if (usable(signals.sensed)) {
     model.sensor = fit_side({signals.drive, linear, signals.sensed, signals.sample_time},
-                            structure_of(options, creep), choose);
+                            structure_of(options, creep), options, choose);
   }
   if (usable(signals.strain)) {
     // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19);
@@ -130,7 +165,7 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
     }
     model.actuator = fit_side({signals.drive, inputs, signals.strain, signals.sample_time},
                               linear_side ? OperatorStructure{} : structure_of(options, creep),
-                              choose && !linear_side);
+                              options, choose && !linear_side);
     if (!squared.empty()) {
       model.actuator->quadratic = model.actuator->linear_gains.back();
       model.actuator->linear_gains.pop_back();

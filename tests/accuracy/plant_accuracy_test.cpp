@@ -137,12 +137,18 @@ TEST(PlantAccuracy, SelfSensingOnAHeldOutRecordingMeetsTheGoals) {
   const Recorded validation = record_mix(2);  // other noise: not used to fit anything
   const Figures hc = reconstruct(identified().hysteresis_creep, validation);
   const Figures lin = reconstruct(identified().linear, validation);
+  std::printf(
+      "hysteresis-creep: S_hat %.3f %% (max %.3f %%), T_hat %.3f %% (max %.2f %%); "
+      "linear: S_hat %.2f %%, T_hat %.2f %%\n",
+      100 * hc.strain.nrmse, 100 * hc.strain.max, 100 * hc.stress.nrmse, 100 * hc.stress.max,
+      100 * lin.strain.nrmse, 100 * lin.stress.nrmse);
   RecordProperty("S_hat_nrmse", std::to_string(hc.strain.nrmse));
   RecordProperty("T_hat_nrmse", std::to_string(hc.stress.nrmse));
-  // Issue 4 goals: S_hat nrmse <= 0.3 %, max <= 1.5 %; T_hat nrmse <= 1.5 %.
-  EXPECT_LE(hc.strain.nrmse, 0.003);
+  // Issue 4 goals: S_hat nrmse <= 0.3 %, max <= 1.5 %; T_hat nrmse <= 1.5 %. Measured 0.195 %,
+  // 1.24 % and 0.665 %: the bounds below are about 1.3x of that, to catch a regression.
+  EXPECT_LE(hc.strain.nrmse, 0.0025);
   EXPECT_LE(hc.strain.max, 0.015);
-  EXPECT_LE(hc.stress.nrmse, 0.015);
+  EXPECT_LE(hc.stress.nrmse, 0.0085);
   // The linear model on the same data is far worse.
   EXPECT_GT(lin.strain.nrmse, 5.0 * hc.strain.nrmse);
   EXPECT_GT(lin.stress.nrmse, 5.0 * hc.stress.nrmse);
@@ -215,7 +221,8 @@ TEST(PlantAccuracy, InverseCompensationTracksAHeldOutTrajectory) {
   RecordProperty("uncompensated_nrmse", std::to_string(uncompensated));
   std::printf("tracking nrmse: compensated %.3f %%, linear inverse %.3f %%\n", 100 * compensated,
               100 * uncompensated);
-  EXPECT_LT(compensated, 0.02);
+  // Measured 0.424 % against 6.80 % for the linear inverse.
+  EXPECT_LT(compensated, 0.0055);
   EXPECT_LT(compensated, 0.3 * uncompensated);
 }
 

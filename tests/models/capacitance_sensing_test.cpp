@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <vector>
 
@@ -60,8 +61,10 @@ TEST(CapacitanceSensing, StressFromTheEstimatedCapacitanceOfAStressedStack) {
     t_hat.push_back(ch.stress(cap[k]));
   const auto q = identification::fit_quality(std::span(stress).subspan(half), t_hat);
   // Measured: nrmse 1.7 %, max 6.2 % of the stress range, on the second half.
-  EXPECT_LT(q.nrmse, 0.03);
-  EXPECT_LT(q.max, 0.1);
+  std::printf("T_hat from capacitance: nrmse %.2f %%, max %.2f %%\n", 100 * q.nrmse, 100 * q.max);
+  // Measured 1.68 % and 6.16 % (docs/results.md); the bounds are about 1.3x.
+  EXPECT_LT(q.nrmse, 0.022);
+  EXPECT_LT(q.max, 0.08);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <vector>
 
@@ -98,10 +99,13 @@ TEST(StressHysteresis, ReconstructsStressWhereTheAffineModelCannot) {
   const auto q_vec = fit_quality(held(r.t), t_vec);
   const auto q_aff = fit_quality(held(r.t), t_aff);
   const auto q_s = fit_quality(held(r.s), s_vec);
-  // Measured: T_hat 0.68 % (affine model 13.9 %), S_hat 0.36 % of range, held out.
-  EXPECT_LT(q_vec.nrmse, 0.015);
+  std::printf("held out: T_hat %.3f %% (affine model %.2f %%), S_hat %.3f %%\n", 100 * q_vec.nrmse,
+              100 * q_aff.nrmse, 100 * q_s.nrmse);
+  // Measured: T_hat 0.687 % (affine model 9.06 %), S_hat 0.365 % of range, held out; the bounds
+  // are about 1.3x (docs/results.md).
+  EXPECT_LT(q_vec.nrmse, 0.009);
   EXPECT_LT(q_vec.nrmse, 0.2 * q_aff.nrmse);
-  EXPECT_LT(q_s.nrmse, 0.01);
+  EXPECT_LT(q_s.nrmse, 0.0047);
   EXPECT_EQ(vectorial.status_counts()[SampleStatus::kOk], r.e.size());
 }
 

@@ -24,9 +24,11 @@ struct IdentificationOptions {
   double fastest_eigenvalue{0.0};  // [1/s]; 0: from the sample time (OperatorStructure)
   double slowest_eigenvalue{0.0};  // [1/s]; 0: from the duration
   std::size_t bias_levels{0};      // hinges per play (OperatorStructure::bias_levels)
-  // preisach-creep: choose bias_levels among kBiasLevelCandidates per side, by the output
-  // error on the last quarter of the fitting data of a fit on the first three quarters.
+  // preisach-creep chooses sizes per side on the fitting data alone, by the output error on
+  // its last quarter of a fit on the first three quarters: dead zones between 0 and
+  // dead_zones, then bias_levels among kBiasLevelCandidates.
   bool choose_bias_levels{false};
+  bool choose_dead_zones{false};
 };
 inline constexpr std::array<std::size_t, 3> kBiasLevelCandidates{0, 1, 3};
 [[nodiscard]] IdentificationOptions defaults_for(Structure s) noexcept;
