@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "field_signals.hpp"
@@ -68,6 +69,24 @@ void print_table(const std::vector<ChannelFigures>& fit, const std::vector<Chann
     }
     std::printf("\n");
   }
+}
+
+// What preisach-creep chose on the fitting data (transducer_fit.hpp), read off the model.
+void print_chosen_sizes(const models::TransducerModel& model) {
+  const auto describe = [](const char* name, const std::optional<models::SideModel>& side) {
+    if (!side) return;
+    const auto& s = side->op.superposition;
+    const std::size_t dead_zones = std::max(s.upper_thresholds.size(), s.lower_thresholds.size());
+    std::vector<double> r = side->op.hinges.thresholds;
+    const std::size_t hinges = r.size();
+    std::sort(r.begin(), r.end());
+    const auto plays = static_cast<std::size_t>(std::unique(r.begin(), r.end()) - r.begin());
+    std::printf("  %s: %zu dead zones per side, %zu hinges per play (%zu hinges)\n", name,
+                dead_zones, plays == 0 ? 0 : hinges / plays, hinges);
+  };
+  std::printf("sizes chosen on the fitting data:\n");
+  describe("sensor", model.sensor);
+  describe("actuator", model.actuator);
 }
 
 void run_identify(const IdentifyOptions& opt) {
@@ -132,6 +151,7 @@ void run_identify(const IdentifyOptions& opt) {
       "selfsense identify: %s from %s (%zu samples, Ts %g s); fitted on the first %zu in "
       "%.2f s\n",
       opt.structure.c_str(), signals.source.c_str(), n, signals.sample_time, split, seconds);
+  if (*structure == models::Structure::kPreisachCreep) print_chosen_sizes(model);
   print_table(fit, held);
 
   nlohmann::json report = {{"structure", opt.structure},
