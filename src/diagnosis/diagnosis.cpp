@@ -24,6 +24,9 @@ struct Candidate {
   bool on_sensed;  // the reconstruction can invert it on the sensed channel
   bool on_strain;
   Needs needs;
+  // The hysteresis operators bend to many residuals (a static curve, a slow drift under a
+  // periodic drive): chosen only when no specific physics explains the residual significantly.
+  bool generic{false};
 };
 
 const std::vector<Candidate>& candidates() {
@@ -37,6 +40,18 @@ const std::vector<Candidate>& candidates() {
       {"delay", {CorrectionTerm::kDelay}, true, true, Needs::kNothing},
       {"dynamics", {CorrectionTerm::kDynamics}, false, true, Needs::kNothing},
       {"creep", {CorrectionTerm::kCreep, CorrectionTerm::kOffset}, false, true, Needs::kNothing},
+      {"hysteresis",
+       {CorrectionTerm::kHysteresis, CorrectionTerm::kOffset},
+       true,
+       true,
+       Needs::kNothing,
+       true},
+      {"asymmetric_hysteresis",
+       {CorrectionTerm::kAsymmetricHysteresis, CorrectionTerm::kOffset},
+       true,
+       true,
+       Needs::kNothing,
+       true},
       {"temperature_dependence",
        {CorrectionTerm::kTemperature, CorrectionTerm::kOffset},
        true,
@@ -277,6 +292,34 @@ void describe(Finding& f, const ChannelCorrection& c, const ChannelData& ch, con
                  tail;
     f.feature_name = "log10 time since the drive last stepped [s]";
     f.feature = log_time_since_step(s.drive, s.sample_time);
+  } else if (f.effect == "hysteresis" || f.effect == "asymmetric_hysteresis") {
+    // The loop the added plays draw: their term's spread over the recording.
+    models::ChannelCorrection plays_only;
+    plays_only.hysteresis_thresholds = c.hysteresis_thresholds;
+    plays_only.hysteresis_weights = c.hysteresis_weights;
+    plays_only.hinge_thresholds = c.hinge_thresholds;
+    plays_only.hinge_levels = c.hinge_levels;
+    plays_only.hinge_weights = c.hinge_weights;
+    models::CorrectionStage stage(plays_only, s.sample_time);
+    std::vector<double> term(s.drive.size());
+    for (std::size_t k = 0; k < term.size(); ++k) {
+      models::CorrectionStage::Inputs in;
+      in.drive = s.drive[k];
+      term[k] = stage.step(in);
+    }
+    const double spread = range_of(term);
+    f.evidence = "the recorded " + n +
+                 (f.effect == "hysteresis"
+                      ? format(" differs on rising and falling branches at the same drive beyond "
+                               "the model (the added loop spans %.3g %% of range)",
+                               spread * pct)
+                      : format(" has loops whose shape changes with their offset and saturates "
+                               "at one end beyond the model (the added term spans %.3g %% of "
+                               "range)",
+                               spread * pct)) +
+                 tail;
+    f.feature_name = "drive";
+    f.feature.assign(s.drive.begin(), s.drive.end());
   } else if (f.effect == "temperature_dependence") {
     f.evidence = "the recorded " + n +
                  format(
@@ -398,6 +441,12 @@ std::size_t complexity(const std::vector<CorrectionTerm>& terms) {
       case CorrectionTerm::kCreep:
         n += 5;
         break;
+      case CorrectionTerm::kHysteresis:
+        n += 8;  // plays (correction_fit.cpp)
+        break;
+      case CorrectionTerm::kAsymmetricHysteresis:
+        n += 8 + 27;  // plays and their hinges
+        break;
       default:
         n += 1;
         break;
@@ -464,6 +513,9 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
     for (const Candidate& c : candidates()) {
       if (std::find(used.begin(), used.end(), &c) != used.end()) continue;
       if (!applicable(c, ch, s, !cs.sensed.empty(), charge_drive)) continue;
+      // A hysteresis operator fitted to one stretch would bend to anything in it: transients
+      // are named by specific physics only.
+      if (c.generic) continue;
       identification::CorrectionFit local;
       try {
         local =
@@ -639,9 +691,22 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       if (tried.empty()) break;
       std::sort(tried.begin(), tried.end(),
                 [](const Tried& a, const Tried& b) { return a.explains > b.explains; });
+      const auto significant = [&](const Tried& t) {
+        return t.explains >= options.min_explains && t.typical >= options.min_explains &&
+               t.explains * current_sse >= options.min_share * original_sse;
+      };
+      // Specific physics first: when one is significant, the generic candidates only compete
+      // as alternatives (and may explain what is left in a later round).
+      std::size_t pool = tried.size();
+      if (std::any_of(tried.begin(), tried.end(),
+                      [&](const Tried& t) { return !t.candidate->generic && significant(t); })) {
+        const auto specific_end = std::stable_partition(
+            tried.begin(), tried.end(), [](const Tried& t) { return !t.candidate->generic; });
+        pool = static_cast<std::size_t>(specific_end - tried.begin());
+      }
       // Of the candidates explaining about as much as the best, the simplest.
       std::size_t chosen = 0;
-      for (std::size_t i = 1; i < tried.size(); ++i) {
+      for (std::size_t i = 1; i < pool; ++i) {
         if (1.0 - tried[i].explains <= options.parsimony_ratio * (1.0 - tried.front().explains) &&
             complexity(tried[i].candidate->terms) < complexity(tried[chosen].candidate->terms)) {
           chosen = i;
@@ -649,10 +714,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       }
       std::swap(tried[0], tried[chosen]);
       const Tried& best = tried.front();
-      if (!(best.explains >= options.min_explains && best.typical >= options.min_explains &&
-            best.explains * current_sse >= options.min_share * original_sse)) {
-        break;
-      }
+      if (!significant(best)) break;
 
       Finding f;
       f.effect = best.candidate->effect;

@@ -20,7 +20,37 @@ double at(std::span<const double> s, std::size_t k, double fallback) noexcept {
 struct Columns {
   std::vector<std::vector<double>> phi{};
   std::vector<double> creep_eigenvalues{};
+  std::vector<double> play_thresholds{};
+  std::vector<double> hinge_thresholds{};
+  std::vector<double> hinge_levels{};
 };
+
+constexpr std::size_t kCorrectionPlays = 8;
+constexpr std::size_t kHingeLevels = 3;
+
+// The drive's plays on an even grid up to half its range (a wider play would never move after
+// one sweep), each run from rest at the first sample: one column per play, sample-major.
+std::vector<std::vector<double>> drive_plays(std::span<const double> x,
+                                             std::vector<double>& thresholds) {
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  const double range = *hi - *lo;
+  thresholds.clear();
+  std::vector<std::vector<double>> out;
+  if (!(range > 0.0)) return out;
+  for (std::size_t i = 1; i <= kCorrectionPlays; ++i) {
+    const double r =
+        0.5 * range * static_cast<double>(i) / static_cast<double>(kCorrectionPlays + 1);
+    thresholds.push_back(r);
+    std::vector<double> p(x.size());
+    double state = x[0];
+    for (std::size_t k = 0; k < x.size(); ++k) {
+      state = std::min(std::max(state, x[k] - r), x[k] + r);
+      p[k] = state;
+    }
+    out.push_back(std::move(p));
+  }
+  return out;
+}
 
 std::vector<double> log_spaced(double from, double to, std::size_t per_decade) {
   std::vector<double> out;
@@ -99,6 +129,29 @@ Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm>
         }
         break;
       }
+      case CorrectionTerm::kHysteresis:
+      case CorrectionTerm::kAsymmetricHysteresis: {
+        const std::vector<std::vector<double>> plays = drive_plays(s.drive, c.play_thresholds);
+        for (const auto& p : plays)
+          add([&](std::size_t k) { return p[k] - s.drive[k]; });
+        if (t == CorrectionTerm::kHysteresis || plays.empty()) break;
+        // Hinges at levels spread over each play's span [lo + r, hi - r] (and x's own).
+        const auto [lo, hi] = std::minmax_element(s.drive.begin(), s.drive.end());
+        for (std::size_t i = 0; i <= plays.size(); ++i) {
+          const double r = i == 0 ? 0.0 : c.play_thresholds[i - 1];
+          const std::span<const double> p =
+              i == 0 ? s.drive : std::span<const double>(plays[i - 1]);
+          for (std::size_t j = 1; j <= kHingeLevels; ++j) {
+            const double level = *lo + r +
+                                 (*hi - *lo - 2.0 * r) * static_cast<double>(j) /
+                                     static_cast<double>(kHingeLevels + 1);
+            c.hinge_thresholds.push_back(r);
+            c.hinge_levels.push_back(level);
+            add([&](std::size_t k) { return std::max(p[k] - level, 0.0); });
+          }
+        }
+        break;
+      }
       case CorrectionTerm::kDynamics:
       case CorrectionTerm::kLeakage:
       case CorrectionTerm::kDelay:
@@ -142,6 +195,19 @@ void apply_coefficients(std::span<const CorrectionTerm> terms, const Columns& co
         for (std::size_t j = 0; j < columns.creep_eigenvalues.size(); ++j) {
           out.creep_weights.push_back(c[i++]);
         }
+        break;
+      case CorrectionTerm::kHysteresis:
+      case CorrectionTerm::kAsymmetricHysteresis:
+        out.hysteresis_thresholds = columns.play_thresholds;
+        out.hysteresis_weights.clear();
+        for (std::size_t j = 0; j < columns.play_thresholds.size(); ++j)
+          out.hysteresis_weights.push_back(c[i++]);
+        if (t == CorrectionTerm::kHysteresis) break;
+        out.hinge_thresholds = columns.hinge_thresholds;
+        out.hinge_levels = columns.hinge_levels;
+        out.hinge_weights.clear();
+        for (std::size_t j = 0; j < columns.hinge_thresholds.size(); ++j)
+          out.hinge_weights.push_back(c[i++]);
         break;
       default:
         break;

@@ -142,6 +142,18 @@ auto correction_scalars(C& c) {
   }};
 }
 
+// The play terms of a correction (hysteresis, asymmetric_hysteresis), written when present.
+template <typename C>
+auto correction_sequences(C& c) {
+  return std::array<std::pair<const char*, decltype(&c.hysteresis_thresholds)>, 5>{{
+      {"hysteresis_thresholds", &c.hysteresis_thresholds},
+      {"hysteresis_weights", &c.hysteresis_weights},
+      {"hinge_thresholds", &c.hinge_thresholds},
+      {"hinge_levels", &c.hinge_levels},
+      {"hinge_weights", &c.hinge_weights},
+  }};
+}
+
 std::optional<ChannelCorrection> read_correction(YamlMap& corrections, std::string_view key) {
   std::optional<YamlMap> m = corrections.optional_map(key);
   if (!m) return std::nullopt;
@@ -150,6 +162,9 @@ std::optional<ChannelCorrection> read_correction(YamlMap& corrections, std::stri
     m->read(name, *field);
   if (m->has("creep_eigenvalues")) m->read_sequence("creep_eigenvalues", c.creep_eigenvalues);
   if (m->has("creep_weights")) m->read_sequence("creep_weights", c.creep_weights);
+  for (const auto& [name, field] : correction_sequences(c)) {
+    if (m->has(name)) m->read_sequence(name, *field);
+  }
   m->finish();
   return c;
 }
@@ -279,6 +294,9 @@ void emit_correction(YAML::Emitter& out, const char* key, const ChannelCorrectio
   if (!c.creep_eigenvalues.empty()) {
     emit_sequence(out, "creep_eigenvalues", c.creep_eigenvalues);
     emit_sequence(out, "creep_weights", c.creep_weights);
+  }
+  for (const auto& [name, field] : correction_sequences(c)) {
+    if (!field->empty()) emit_sequence(out, name, *field);
   }
   out << YAML::EndMap;
 }

@@ -1,5 +1,6 @@
 #include "selfsense/models/channel_correction.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -58,6 +59,50 @@ bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) co
   if (leakage_tau_s < 0.0) return fail(why, prefix + ".leakage_tau_s: must be >= 0 (0: none)");
   if (delay_s < 0.0) return fail(why, prefix + ".delay_s: must be >= 0");
   if (1.0 + gain <= 0.0) return fail(why, prefix + ".gain: 1 + gain must be > 0");
+  return plays_valid(prefix, why);
+}
+
+bool ChannelCorrection::plays_valid(const std::string& prefix, std::string* why) const {
+  if (hysteresis_weights.size() != hysteresis_thresholds.size()) {
+    return fail(why, prefix + ".hysteresis_weights: needs one weight per threshold");
+  }
+  if (hysteresis_thresholds.size() > kMaxCorrectionPlays) {
+    return fail(why, prefix + ".hysteresis_thresholds: at most " +
+                         std::to_string(kMaxCorrectionPlays) + " plays");
+  }
+  for (std::size_t i = 0; i < hysteresis_thresholds.size(); ++i) {
+    const double r = hysteresis_thresholds[i];
+    const double before = i == 0 ? 0.0 : hysteresis_thresholds[i - 1];
+    if (!(std::isfinite(r) && r > before)) {
+      return fail(why, prefix + ".hysteresis_thresholds[" + std::to_string(i) +
+                           "]: must be > 0 and increasing");
+    }
+    if (!std::isfinite(hysteresis_weights[i])) {
+      return fail(why, prefix + ".hysteresis_weights[" + std::to_string(i) + "]: must be finite");
+    }
+  }
+  if (hinge_levels.size() != hinge_thresholds.size() ||
+      hinge_weights.size() != hinge_thresholds.size()) {
+    return fail(why, prefix + ".hinge_levels: hinge thresholds, levels and weights differ in size");
+  }
+  if (hinge_thresholds.size() > kMaxCorrectionHinges) {
+    return fail(why, prefix + ".hinge_thresholds: at most " + std::to_string(kMaxCorrectionHinges) +
+                         " hinges");
+  }
+  for (std::size_t h = 0; h < hinge_thresholds.size(); ++h) {
+    const double r = hinge_thresholds[h];
+    const bool known =
+        r == 0.0 || std::find(hysteresis_thresholds.begin(), hysteresis_thresholds.end(), r) !=
+                        hysteresis_thresholds.end();
+    if (!known) {
+      return fail(why, prefix + ".hinge_thresholds[" + std::to_string(h) +
+                           "]: must be 0 or one of hysteresis_thresholds");
+    }
+    if (!std::isfinite(hinge_levels[h]) || !std::isfinite(hinge_weights[h])) {
+      return fail(why, prefix + ".hinge_levels[" + std::to_string(h) +
+                           "]: level and weight must be finite");
+    }
+  }
   return true;
 }
 
@@ -88,7 +133,8 @@ bool ChannelCorrection::empty() const noexcept {
          temperature_offset_per_k == 0.0 && temperature_drive_per_k == 0.0 &&
          stress_gain_per_pa == 0.0 && stress_quadratic_per_pa2 == 0.0 && drive_quadratic == 0.0 &&
          drive_cubic == 0.0 && sensed_quadratic == 0.0 && creep_weights.empty() &&
-         dynamics_frequency_hz == 0.0 && leakage_tau_s == 0.0 && delay_s == 0.0;
+         dynamics_frequency_hz == 0.0 && leakage_tau_s == 0.0 && delay_s == 0.0 &&
+         hysteresis_weights.empty() && hinge_weights.empty();
 }
 
 CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sample_time)
@@ -97,6 +143,14 @@ CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sam
   if (!c_.is_valid("correction", &why)) throw std::invalid_argument(why);
   if (!(sample_time > 0.0)) throw std::invalid_argument("correction: sample time must be > 0");
   creep_count_ = c_.creep_eigenvalues.size();
+  play_count_ = c_.hysteresis_thresholds.size();
+  std::copy(c_.hysteresis_thresholds.begin(), c_.hysteresis_thresholds.end(), play_r_.begin() + 1);
+  hinge_count_ = c_.hinge_thresholds.size();
+  const auto rows_end = play_r_.begin() + static_cast<std::ptrdiff_t>(1 + play_count_);
+  for (std::size_t h = 0; h < hinge_count_; ++h) {
+    const auto row = std::find(play_r_.begin(), rows_end, c_.hinge_thresholds[h]);
+    hinge_row_[h] = static_cast<std::size_t>(row - play_r_.begin());
+  }
   for (std::size_t j = 0; j < creep_count_; ++j) {
     alpha_[j] = -std::expm1(-c_.creep_eigenvalues[j] * sample_time);
   }
@@ -183,6 +237,26 @@ double CorrectionStage::filters(double v) noexcept {
   return delayed(w);
 }
 
+double CorrectionStage::play_terms(double drive) noexcept {
+  if (play_count_ == 0 && hinge_count_ == 0) return 0.0;
+  if (!plays_started_) {
+    plays_started_ = true;
+    plays_.fill(drive);
+  }
+  double sum = 0.0;
+  for (std::size_t i = 0; i < play_count_; ++i) {
+    const double r = play_r_[i + 1];
+    plays_[i] = std::min(std::max(plays_[i], drive - r), drive + r);
+    sum += c_.hysteresis_weights[i] * (plays_[i] - drive);
+  }
+  for (std::size_t h = 0; h < hinge_count_; ++h) {
+    const std::size_t row = hinge_row_[h];
+    const double p = row == 0 ? drive : plays_[row - 1];
+    sum += c_.hinge_weights[h] * std::max(p - c_.hinge_levels[h], 0.0);
+  }
+  return sum;
+}
+
 double CorrectionStage::step(const Inputs& in) noexcept {
   const bool first = !started_;
   if (first) {
@@ -192,7 +266,7 @@ double CorrectionStage::step(const Inputs& in) noexcept {
       z_[j] = in.response;
   }
   double v = in.y * gain_at(in) + c_.stress_gain_per_pa * in.stress * in.response +
-             c_.stress_quadratic_per_pa2 * in.stress * in.stress + terms(in);
+             c_.stress_quadratic_per_pa2 * in.stress * in.stress + terms(in) + play_terms(in.drive);
   for (std::size_t j = 0; j < creep_count_; ++j) {
     z_[j] += alpha_[j] * (in.response - z_[j]);
     v += c_.creep_weights[j] * (z_[j] - y0_);
@@ -224,7 +298,7 @@ double CorrectionStage::invert(double measured, const Inputs& in) noexcept {
     w_prev_ = w;
   }
   started_ = true;
-  return (w - terms(in)) / gain_at(in);
+  return (w - terms(in) - play_terms(in.drive)) / gain_at(in);
 }
 
 double CorrectionStage::solve_stress(double t_lin, double coupling,
@@ -250,10 +324,12 @@ void CorrectionStage::save_state(std::span<double> out) const noexcept {
                            static_cast<double>(head_),
                            static_cast<double>(drive_head_),
                            drive_started_ ? 1.0 : 0.0,
-                           0.0};
+                           plays_started_ ? 1.0 : 0.0};
   for (const double v : head)
     out[i++] = v;
   for (const double v : z_)
+    out[i++] = v;
+  for (const double v : plays_)
     out[i++] = v;
   for (const double v : line_)
     out[i++] = v;
@@ -274,8 +350,10 @@ void CorrectionStage::restore_state(std::span<const double> in) noexcept {
   head_ = static_cast<std::size_t>(in[i++]) % kLine;
   drive_head_ = static_cast<std::size_t>(in[i++]) % kLine;
   drive_started_ = in[i++] != 0.0;
-  ++i;
+  plays_started_ = in[i++] != 0.0;
   for (double& v : z_)
+    v = in[i++];
+  for (double& v : plays_)
     v = in[i++];
   for (double& v : line_)
     v = in[i++];

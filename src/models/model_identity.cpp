@@ -67,6 +67,13 @@ void add_correction(Fnv1a& h, const std::optional<ChannelCorrection>& c) noexcep
   }
   h.add(c->creep_eigenvalues);
   h.add(c->creep_weights);
+  if (!c->hysteresis_thresholds.empty() || !c->hinge_thresholds.empty()) {
+    h.add(c->hysteresis_thresholds);  // corrections without plays keep the identity they had
+    h.add(c->hysteresis_weights);
+    h.add(c->hinge_thresholds);
+    h.add(c->hinge_levels);
+    h.add(c->hinge_weights);
+  }
 }
 
 void add_vectorial_side(Fnv1a& h, const std::optional<StressHysteresisSide>& side) noexcept {

@@ -3,6 +3,7 @@
 // read from model files, refused by name where no inverse exists.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -30,6 +31,11 @@ ChannelCorrection sensed_correction() {
   c.drive_cubic = -2e-22;
   c.leakage_tau_s = 0.5;
   c.delay_s = 3.5 * kTs;
+  c.hysteresis_thresholds = {2e5, 5e5};  // hysteresis and asymmetric_hysteresis
+  c.hysteresis_weights = {1e-9, -4e-10};
+  c.hinge_thresholds = {0.0, 5e5};
+  c.hinge_levels = {1.2e6, 8e5};
+  c.hinge_weights = {3e-10, -2e-10};
   return c;
 }
 
@@ -42,6 +48,11 @@ ChannelCorrection strain_correction() {
   c.creep_weights = {0.01, 0.012, 0.015};
   c.dynamics_frequency_hz = 800.0;
   c.dynamics_damping = 0.1;
+  c.hysteresis_thresholds = {3e5};
+  c.hysteresis_weights = {2e-11};
+  c.hinge_thresholds = {3e5};
+  c.hinge_levels = {9e5};
+  c.hinge_weights = {1e-11};
   return c;
 }
 
@@ -93,6 +104,37 @@ TEST(ChannelCorrection, ForwardCorrectionChangesTheOutputAsWritten) {
     const double y = a.step(e, -1e6).sensed;
     EXPECT_NEAR(b.step(e, -1e6).sensed, 1.1 * y + 2e-3, 1e-12);
   }
+}
+
+// The play terms by their definition: sum w_i (p_i - x) + sum c_h max(0, p_{r_h} - b_h).
+TEST(ChannelCorrection, PlayTermsAddWhatTheirDefinitionSays) {
+  ChannelCorrection c;
+  c.hysteresis_thresholds = {0.1, 0.3};
+  c.hysteresis_weights = {2.0, -0.5};
+  c.hinge_thresholds = {0.0, 0.3};
+  c.hinge_levels = {0.4, 0.2};
+  c.hinge_weights = {1.5, 3.0};
+  CorrectionStage stage(c, kTs);
+  double p1 = 0.0;
+  double p3 = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    const double x = std::sin(0.05 * k) * (1.0 - 0.002 * k);
+    if (k == 0) p1 = p3 = x;
+    p1 = std::min(std::max(p1, x - 0.1), x + 0.1);
+    p3 = std::min(std::max(p3, x - 0.3), x + 0.3);
+    const double expected = 2.0 * (p1 - x) - 0.5 * (p3 - x) + 1.5 * std::max(x - 0.4, 0.0) +
+                            3.0 * std::max(p3 - 0.2, 0.0);
+    CorrectionStage::Inputs in;
+    in.y = 0.25;
+    in.response = 0.25;
+    in.drive = x;
+    ASSERT_NEAR(stage.step(in), 0.25 + expected, 1e-12) << k;
+  }
+  ChannelCorrection unknown = c;
+  unknown.hinge_thresholds = {0.2, 0.3};
+  std::string why;
+  EXPECT_FALSE(unknown.is_valid("corrections.sensed", &why));
+  EXPECT_NE(why.find("corrections.sensed.hinge_thresholds[0]"), std::string::npos) << why;
 }
 
 TEST(ChannelCorrection, StateSavedAndRestoredContinuesBitIdentically) {

@@ -26,10 +26,12 @@ enum class CorrectionTerm : std::uint8_t {
   kStressQuadratic,  // T^2: a stress-dependent coupling seen on the sensed channel
   kDrivePolynomial,
   kSensedQuadratic,
-  kCreep,     // log-spaced lags of y
-  kDynamics,  // searched: f0, zeta
-  kLeakage,   // searched: tau
-  kDelay,     // searched: delay
+  kCreep,                 // log-spaced lags of y
+  kHysteresis,            // plays of the drive, p_i - x (8 thresholds up to half its range)
+  kAsymmetricHysteresis,  // those plays and hinges on them and on x (3 levels each)
+  kDynamics,              // searched: f0, zeta
+  kLeakage,               // searched: tau
+  kDelay,                 // searched: delay
 };
 
 struct CorrectionSignals {

@@ -9,6 +9,10 @@
 //         + drive_quadratic x^2 + drive_cubic x^3                permittivity_nonlinearity
 //         + sensed_quadratic s^2                                 electrostriction (S ~ P^2, P ~ D)
 //         + sum_j creep_weights_j (z_j - r_0)                    creep (eq. 28: K = L[H])
+//         + sum_i hysteresis_weights_i (p_i - x)                 hysteresis (plays of the drive)
+//         + sum_h hinge_weights_h max(0, p_{r_h} - b_h)          asymmetric_hysteresis (hinges
+//                                                                on the plays: the Preisach class)
+//   p_i[k] = max(x[k] - r_i, min(x[k] + r_i, p_i[k-1])),  p_i = x at the start (p_0 = x)
 //   z_j[k] = z_j[k-1] + (1 - exp(-lambda_j Ts)) (r[k] - z_j[k-1]),  z_j = r_0 = r at the start
 //   w = second-order low-pass of v, unity DC gain, f0 and zeta    dynamics
 //       (bilinear transform prewarped at f0)
@@ -23,11 +27,11 @@
 //
 // Reconstruction needs the inverse on the sensed channel: the leakage is undone
 // (w[k] = w[k-1] + (m[k] - g m[k-1]) / c), a delay moves to the drive, and the additive and
-// gain terms that do not depend on T are solved for y; stress_quadratic is solved with the
-// sensor coupling d after the kernel: d T + q' T^2 = d T_lin (q' = q / (1 + gain terms)). Terms
-// that depend on T or on y's history (stress_gain, creep, dynamics) make the sensor side
-// non-invertible in closed form: invertible() says so and the Reconstruction refuses such a model
-// by name.
+// gain terms that do not depend on T (the play terms depend on the drive alone) are solved for y;
+// stress_quadratic is solved with the sensor coupling d after the kernel: d T + q' T^2 = d T_lin
+// (q' = q / (1 + gain terms)). Terms that depend on T or on y's history (stress_gain, creep,
+// dynamics) make the sensor side non-invertible in closed form: invertible() says so and the
+// Reconstruction refuses such a model by name.
 //
 // Real-time safe after construction: step(), invert(), save/restore are noexcept and allocate
 // nothing.
@@ -57,8 +61,13 @@ struct ChannelCorrection {
   std::vector<double> creep_weights{};
   double dynamics_frequency_hz{0.0};  // 0: none
   double dynamics_damping{0.0};
-  double leakage_tau_s{0.0};  // 0: none
-  double delay_s{0.0};        // 0: none
+  double leakage_tau_s{0.0};                    // 0: none
+  double delay_s{0.0};                          // 0: none
+  std::vector<double> hysteresis_thresholds{};  // r_i > 0, increasing [unit of the drive]
+  std::vector<double> hysteresis_weights{};
+  std::vector<double> hinge_thresholds{};  // each 0 or one of hysteresis_thresholds
+  std::vector<double> hinge_levels{};      // b_h [unit of the drive]
+  std::vector<double> hinge_weights{};
 
   // Every value finite, sizes agree, dynamics_damping > 0 with a frequency, taus and delay
   // >= 0; names the key under `prefix` ("corrections.sensed.leakage_tau_s: ...").
@@ -66,11 +75,14 @@ struct ChannelCorrection {
   // Closed-form inverse exists (header comment); otherwise *why names the term.
   [[nodiscard]] bool invertible(const std::string& prefix, std::string* why) const;
   [[nodiscard]] bool empty() const noexcept;
+  [[nodiscard]] bool plays_valid(const std::string& prefix, std::string* why) const;
   friend bool operator==(const ChannelCorrection&, const ChannelCorrection&) = default;
 };
 
 inline constexpr std::size_t kMaxCorrectionDelaySamples{64};
 inline constexpr std::size_t kMaxCorrectionCreep{12};
+inline constexpr std::size_t kMaxCorrectionPlays{16};
+inline constexpr std::size_t kMaxCorrectionHinges{64};
 
 class CorrectionStage {
  public:
@@ -106,11 +118,13 @@ class CorrectionStage {
 
  private:
   static constexpr std::size_t kLine = kMaxCorrectionDelaySamples + 2;
-  static constexpr std::size_t kStateSize = 12 + kMaxCorrectionCreep + 2 * kLine;
+  static constexpr std::size_t kStateSize =
+      12 + kMaxCorrectionCreep + kMaxCorrectionPlays + 2 * kLine;
 
   double terms(const Inputs& in) const noexcept;  // the additive/gain terms except creep
   double gain_at(const Inputs& in) const noexcept;
-  double filters(double v) noexcept;  // dynamics, leakage, delay
+  double filters(double v) noexcept;         // dynamics, leakage, delay
+  double play_terms(double drive) noexcept;  // advances the plays; hysteresis + hinge terms
   double delayed(double value) noexcept;
   double push_delayed(std::array<double, kLine>& line, std::size_t& head,
                       double value) const noexcept;
@@ -120,24 +134,30 @@ class CorrectionStage {
   std::size_t creep_count_{0};
   // Dynamics: w[k] = b0 v[k] + b1 v[k-1] + b2 v[k-2] - a1 w[k-1] - a2 w[k-2].
   double b0_{1.0}, b1_{0.0}, b2_{0.0}, a1_{0.0}, a2_{0.0};
-  bool dynamics_{false};
   double leak_g_{0.0}, leak_c_{1.0};
-  bool leakage_{false};
   std::size_t delay_whole_{0};
   double delay_frac_{0.0};
-  bool delay_{false};
+  std::array<double, kMaxCorrectionPlays + 1> play_r_{};  // r_0 = 0, then the thresholds
+  std::size_t play_count_{0};                             // plays besides p_0 = x
+  std::array<std::size_t, kMaxCorrectionHinges> hinge_row_{};
+  std::size_t hinge_count_{0};
   // State (saved in this order): started, y0, v1, v2, w1, w2, m, w_prev, head, drive_head,
-  // drive_started, spare; creep z; the output and drive delay lines (rings).
-  bool started_{false};
+  // drive_started, plays_started; creep z; plays; the output and drive delay lines (rings).
   double y0_{0.0};
   double v1_{0.0}, v2_{0.0}, w1_{0.0}, w2_{0.0};
   double m_{0.0}, w_prev_{0.0};
   std::array<double, kMaxCorrectionCreep> z_{};
+  std::array<double, kMaxCorrectionPlays> plays_{};
   std::array<double, kLine> line_{};
   std::size_t head_{0};
   std::array<double, kLine> drive_line_{};
   std::size_t drive_head_{0};
+  bool dynamics_{false};
+  bool leakage_{false};
+  bool delay_{false};
+  bool started_{false};
   bool drive_started_{false};
+  bool plays_started_{false};
 };
 
 }  // namespace selfsense::models
