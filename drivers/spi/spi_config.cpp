@@ -100,7 +100,11 @@ std::vector<std::string> SpiConfig::problems(double loop_rate_hz) const {
   check(d.range_c_per_m2[0] < d.range_c_per_m2[1], "d.range_c_per_m2: needs min < max");
   check(std::isfinite(amplifier.gain_v_per_v) && amplifier.gain_v_per_v > 0.0,
         "amplifier.gain_v_per_v: " + num(amplifier.gain_v_per_v) + " must be > 0");
-  if (p.empty()) {
+  const bool scaling_valid =
+      power_of_two_up_to_128(e.pga_gain) && power_of_two_up_to_128(d.pga_gain) && e.divider > 0.0 &&
+      d.feedback_capacitance_f > 0.0 && transducer.layers >= 1 &&
+      transducer.layer_thickness_m > 0.0 && transducer.electrode_area_m2 > 0.0;
+  if (scaling_valid) {
     // The whole E range must be measurable: both ends inside the ADC's full scale.
     const double fs = 1.2 / e.pga_gain;
     for (const double field : e.range_v_per_m) {

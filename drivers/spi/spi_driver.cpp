@@ -177,7 +177,7 @@ bool SpiDriver::write_dac(double field) noexcept {
 
 bool SpiDriver::activate(std::string* why) {
   const auto fail = [this, why](const std::string& m) {
-    if (why != nullptr && (why->empty() || !m.empty())) *why = m.empty() ? *why : m;
+    if (why != nullptr) *why = m;
     if (own_adc_) own_adc_->close();
     if (own_dac_) own_dac_->close();
     for (GpiodLine* l : {own_drdy_.get(), own_enable_.get(), own_fault_.get()})

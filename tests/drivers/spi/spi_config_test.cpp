@@ -92,6 +92,14 @@ TEST(SpiConfig, ProblemsNameTheirKeys) {
   }
 }
 
+TEST(SpiConfig, EveryProblemIsNamedAtOnce) {
+  Registry registry;
+  const ConfigResult r =
+      load_with({{"osr: 128 ", "osr: 100 "}, {"divider: 125.0", "divider: 50.0"}}, registry);
+  EXPECT_NE(joined(r).find("driver.adc.osr"), std::string::npos) << joined(r);
+  EXPECT_NE(joined(r).find("driver.e.range_v_per_m"), std::string::npos) << joined(r);
+}
+
 TEST(SpiConfig, UnknownKeysAndWordsAreRefused) {
   Registry a;
   const ConfigResult r = load_with({{"input_crc: true", "input_crc: true\n    crc: 1"}}, a);
