@@ -124,7 +124,9 @@ std::vector<std::string> SpiConfig::problems(double loop_rate_hz) const {
   }
   check(gpio.drdy.line >= 0 || pace == Pace::kTimer,
         "gpio.drdy: pace drdy needs the data-ready line");
-  check(!gpio.drdy.active_low || gpio.drdy.line >= 0, "gpio.drdy.active_low: no line");
+  check(gpio.drdy.active_low,
+        "gpio.drdy.active_low: must be true (the ADS131M04's DRDY falls "
+        "when a conversion is ready; the driver waits for falling edges)");
   check(gpio.drdy.line < 0 || !gpio.chip.empty(), "gpio.chip: must name the GPIO chip");
   check(faults.stale_frames >= 0 && faults.stale_frames <= 1000,
         "faults.stale_frames: must be within [0, 1000]");

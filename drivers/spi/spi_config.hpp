@@ -88,9 +88,9 @@ struct LineConfig {
 
 struct GpioConfig {
   std::string chip{"gpiochip0"};
-  LineConfig drdy{};    // active low by the ADC's definition
-  LineConfig enable{};  // amplifier enable output
-  LineConfig fault{};   // amplifier fault input
+  LineConfig drdy{-1, true};  // active low by the ADC's definition (falling edge: data ready)
+  LineConfig enable{};        // amplifier enable output
+  LineConfig fault{};         // amplifier fault input
 };
 
 struct FaultConfig {
