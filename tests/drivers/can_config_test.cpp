@@ -131,11 +131,11 @@ TEST(CanConfig, FdAllowsSixtyFourByteFrames) {
 
 TEST(CanConfig, TheBusThreadPriorityIsChecked) {
   Registry registry;
-  const ConfigResult ok = load_with({{"  priority: 0 ", "  priority: 70 "}}, registry);
+  const ConfigResult ok = load_with({{"  priority: 70 ", "  priority: 0 "}}, registry);
   ASSERT_TRUE(ok.ok()) << joined(ok);
-  EXPECT_EQ(registry.can_config().priority, 70);
+  EXPECT_EQ(registry.can_config().priority, 0);
   Registry bad;
-  const ConfigResult r = load_with({{"  priority: 0 ", "  priority: 120 "}}, bad);
+  const ConfigResult r = load_with({{"  priority: 70 ", "  priority: 120 "}}, bad);
   EXPECT_NE(joined(r).find("driver.priority: 120 must be 0 (normal) or within [1, 99]"),
             std::string::npos)
       << joined(r);
