@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
   test::SpiBench bench(test::emulated_spi_config(kRate), test::daemon_plant(kRate));
   std::string why;
   if (!bench.driver.configure({kTs}, &why) || !bench.driver.activate(&why)) {
-    std::fprintf(stderr, "spi_bench: %s\n", why.c_str());
+    static_cast<void>(std::fprintf(stderr, "spi_bench: %s\n", why.c_str()));
     return 1;
   }
   runtime::ControllerConfig control;
