@@ -5,14 +5,13 @@
 namespace selfsense::drivers::spi::ads131m04 {
 
 std::uint16_t crc16(std::span<const std::uint8_t> bytes, std::uint16_t crc) noexcept {
+  unsigned c = crc;  // unsigned arithmetic throughout (no promotion to int)
   for (const std::uint8_t b : bytes) {
-    crc = static_cast<std::uint16_t>(crc ^ static_cast<std::uint16_t>(b << 8U));
-    for (int bit = 0; bit < 8; ++bit) {
-      crc = (crc & 0x8000U) != 0U ? static_cast<std::uint16_t>((crc << 1U) ^ 0x1021U)
-                                  : static_cast<std::uint16_t>(crc << 1U);
-    }
+    c ^= static_cast<unsigned>(b) << 8U;
+    for (int bit = 0; bit < 8; ++bit)
+      c = (c & 0x8000U) != 0U ? ((c << 1U) ^ 0x1021U) & 0xFFFFU : (c << 1U) & 0xFFFFU;
   }
-  return crc;
+  return static_cast<std::uint16_t>(c);
 }
 
 void put_word16(Frame& f, std::size_t i, std::uint16_t v) noexcept {

@@ -40,7 +40,9 @@ class Dac8563Emulator final : public drivers::spi::SpiBus {
       case dac::Command::kWriteInput:
         each([&](int i) { input_.at(static_cast<std::size_t>(i)) = d.data; });
         each([&](int i) {
-          if ((ldac_mask_ >> i & 1U) != 0U) update(i);
+          if (((static_cast<unsigned>(ldac_mask_) >> static_cast<unsigned>(i)) & 1U) != 0U) {
+            update(i);
+          }
         });
         break;
       case dac::Command::kUpdate:
@@ -59,7 +61,7 @@ class Dac8563Emulator final : public drivers::spi::SpiBus {
         break;
       case dac::Command::kPower:
         for (int i = 0; i < 2; ++i) {
-          if ((d.data >> i & 1U) != 0U)
+          if (((static_cast<unsigned>(d.data) >> static_cast<unsigned>(i)) & 1U) != 0U)
             powered_.at(static_cast<std::size_t>(i)) = (d.data & 0x30U) == 0U;
         }
         break;
