@@ -117,6 +117,10 @@ void read_can_config(io::YamlMap& driver, double loop_rate_hz, CanConfig& out,
   if (stale > 1000000U) problem("stale_cycles", "must be <= 1000000 (0: off)");
   out.stale_cycles = static_cast<std::uint32_t>(std::min<std::uint64_t>(stale, 1000000U));
   driver.read("error_frames", out.error_frames);
+  driver.read("priority", out.priority);
+  if (out.priority < 0 || out.priority > 99) {
+    problem("priority", std::to_string(out.priority) + " must be 0 (normal) or within [1, 99]");
+  }
 
   io::YamlMap signals = driver.map("signals");
   const std::size_t max_bytes = out.max_bytes();

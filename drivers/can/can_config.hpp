@@ -9,6 +9,7 @@
 //     rx_timeout_ms: 20         # E or D older than this: read() reports a timeout
 //     stale_cycles: 0           # this many reads in a row without a new input frame: stale; 0 off
 //     error_frames: true        # subscribe to error frames (counted; bus-off disconnects)
+//     priority: 0               # the bus thread's SCHED_FIFO priority (1..99); 0: normal
 //     signals:                  # e, d, command required; s_ref and t_ref together or not at all
 //       e: {id: 0x101, extended: false, start_bit: 0, length: 32, byte_order: little,
 //           signed: true, scale: 1.0, offset: 0.0}
@@ -43,6 +44,7 @@ struct CanConfig {
   double rx_timeout_ms{20.0};
   std::uint32_t stale_cycles{0};
   bool error_frames{true};
+  int priority{0};  // bus thread SCHED_FIFO priority; 0: normal scheduling
   SignalConfig e{};
   SignalConfig d{};
   SignalConfig s_ref{};

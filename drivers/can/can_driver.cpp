@@ -4,6 +4,9 @@
 #include <linux/can/raw.h>
 #include <net/if.h>
 #include <poll.h>
+#include <pthread.h>
+#include <sched.h>
+#include <sys/eventfd.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -82,6 +85,8 @@ bool CanDriver::activate(std::string* why) {
     if (why != nullptr) *why = m;
     if (socket_ >= 0) ::close(socket_);
     socket_ = -1;
+    if (wake_fd_ >= 0) ::close(wake_fd_);
+    wake_fd_ = -1;
     return false;
   };
   if (!configured_) return fail("can: activate() before configure()");
@@ -131,6 +136,8 @@ bool CanDriver::activate(std::string* why) {
   if (::bind(socket_, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)) < 0) {
     return fail("driver.interface: bind to " + config_.interface + ": " + std::strerror(errno));
   }
+  wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (wake_fd_ < 0) return fail(errno_text("can: eventfd"));
   building_ = CanInputs{};
   latest_.publish(building_);
   last_ = CanInputs{};
@@ -138,10 +145,20 @@ bool CanDriver::activate(std::string* why) {
   repeats_ = 0;
   bus_off_.store(false, std::memory_order_relaxed);
   error_passive_.store(false, std::memory_order_relaxed);
+  send_failed_.store(false, std::memory_order_relaxed);
   stop_.store(false, std::memory_order_relaxed);
+  command_seq_ = 0;
+  sent_seq_ = 0;
+  command_.publish(CanCommand{});
   activated_ns_ = now_ns();
   read_ns_ = activated_ns_;
   thread_ = std::thread([this] { bus_loop(); });
+  priority_granted_ = true;
+  if (config_.priority > 0) {
+    sched_param param{};
+    param.sched_priority = config_.priority;
+    priority_granted_ = pthread_setschedparam(thread_.native_handle(), SCHED_FIFO, &param) == 0;
+  }
   active_ = true;
   return true;
 }
@@ -149,8 +166,14 @@ bool CanDriver::activate(std::string* why) {
 void CanDriver::bus_loop() noexcept {
   canfd_frame frame{};
   while (!stop_.load(std::memory_order_relaxed)) {
-    pollfd p{socket_, POLLIN, 0};
-    if (::poll(&p, 1, kPollTimeoutMs) <= 0) continue;
+    std::array<pollfd, 2> p{{{wake_fd_, POLLIN, 0}, {socket_, POLLIN, 0}}};
+    if (::poll(p.data(), p.size(), kPollTimeoutMs) <= 0) continue;
+    if ((p[0].revents & POLLIN) != 0) {
+      std::uint64_t wakes = 0;
+      static_cast<void>(::read(wake_fd_, &wakes, sizeof(wakes)));
+      send_command();
+    }
+    if ((p[1].revents & POLLIN) == 0) continue;
     for (;;) {
       const ssize_t n = ::recv(socket_, &frame, sizeof(frame), MSG_DONTWAIT);
       if (n < 0) break;
@@ -260,47 +283,74 @@ runtime::DriverStatus CanDriver::read(runtime::InputSample& out) noexcept {
 
 runtime::DriverStatus CanDriver::write(const runtime::OutputCommand& command) noexcept {
   if (!active_) return runtime::DriverStatus::kNotActive;
+  const std::int64_t now = now_ns();
+  command_.publish(CanCommand{command.e, ++command_seq_, read_ok_ ? last_.newest_ns : 0, now});
+  // Wakes the bus thread: adds 1 to the eventfd's counter. Never blocks (non-blocking; the
+  // counter would need 2^64 - 2 unread wakes to be full).
+  const std::uint64_t one = 1;
+  static_cast<void>(::write(wake_fd_, &one, sizeof(one)));
+  read_to_write_.record(now - read_ns_);
+  return send_failed_.load(std::memory_order_relaxed) ? runtime::DriverStatus::kDisconnected
+                                                      : runtime::DriverStatus::kOk;
+}
+
+bool CanDriver::send_frame(double e) noexcept {
   const std::span<std::uint8_t> data(tx_.data, tx_.len);
-  const EncodeResult r = encode(data, config_.command.signal, command.e);
+  const EncodeResult r = encode(data, config_.command.signal, e);
   if (r == EncodeResult::kNotFinite) {
     static_cast<void>(encode(data, config_.command.signal, 0.0));
   }
   if (r != EncodeResult::kOk) bump(n_.saturated);
   const ssize_t n = ::send(socket_, &tx_, tx_size_, MSG_DONTWAIT);
-  const std::int64_t now = now_ns();
   if (n == static_cast<ssize_t>(tx_size_)) {
     bump(n_.writes);
-    if (read_ok_) rx_to_tx_.record(now - last_.newest_ns);
-    read_to_write_.record(now - read_ns_);
-    return runtime::DriverStatus::kOk;
+    send_failed_.store(false, std::memory_order_relaxed);
+    return true;
   }
   if (n < 0 && (errno == EAGAIN || errno == ENOBUFS)) {
-    bump(n_.retries);  // the TX queue is full; the next cycle sends a newer command
-    return runtime::DriverStatus::kOk;
+    bump(n_.retries);  // the TX queue is full; the loop's next command goes out instead
+    return false;
   }
   bump(n_.tx_errors);
-  return runtime::DriverStatus::kDisconnected;
+  send_failed_.store(true, std::memory_order_relaxed);
+  return false;
+}
+
+void CanDriver::send_command() noexcept {
+  CanCommand c{};
+  if (!command_.try_read(c)) {
+    // write() is publishing a newer command; its wake-up follows.
+    return;
+  }
+  if (c.seq == 0 || c.seq == sent_seq_) return;
+  if (c.seq > sent_seq_ + 1 && sent_seq_ != 0) n_.superseded.fetch_add(c.seq - sent_seq_ - 1);
+  sent_seq_ = c.seq;
+  if (!send_frame(c.e)) return;
+  const std::int64_t now = now_ns();
+  tx_latency_.record(now - c.handed_ns);
+  if (c.inputs_ns != 0) rx_to_tx_.record(now - c.inputs_ns);
 }
 
 void CanDriver::deactivate() noexcept {
   if (!active_) return;
-  // The safe output (E = 0) on the bus, then the bus thread stops and the socket closes.
-  const std::span<std::uint8_t> data(tx_.data, tx_.len);
-  static_cast<void>(encode(data, config_.command.signal, 0.0));
-  if (::send(socket_, &tx_, tx_size_, MSG_DONTWAIT) == static_cast<ssize_t>(tx_size_)) {
-    bump(n_.writes);
-  }
+  // The bus thread stops, then the safe output (E = 0) goes on the bus and the socket closes.
   stop_.store(true, std::memory_order_relaxed);
+  const std::uint64_t one = 1;
+  static_cast<void>(::write(wake_fd_, &one, sizeof(one)));
   if (thread_.joinable()) thread_.join();
+  static_cast<void>(send_frame(0.0));
   ::close(socket_);
   socket_ = -1;
+  ::close(wake_fd_);
+  wake_fd_ = -1;
   active_ = false;
   // Not real-time here: the loop has stopped. One line for the log (and the measured figures).
   const runtime::DriverCounters c = counters();
   static_cast<void>(std::fprintf(
       stderr,
       "can: %s: rx_to_tx_us p50=%.0f p99=%.0f max=%.0f read_to_write_us p50=%.1f p99=%.1f "
-      "max=%.1f (n=%lld); reads=%llu writes=%llu errors=%llu timeouts=%llu stale=%llu "
+      "max=%.1f (n=%lld) handover_to_send_us p50=%.1f p99=%.1f max=%.1f; reads=%llu writes=%llu "
+      "errors=%llu timeouts=%llu stale=%llu "
       "bad_data=%llu retries=%llu reconnects=%llu device_faults=%llu\n",
       config_.interface.c_str(), static_cast<double>(rx_to_tx_.percentile_ns(0.5)) / 1e3,
       static_cast<double>(rx_to_tx_.percentile_ns(0.99)) / 1e3,
@@ -308,7 +358,10 @@ void CanDriver::deactivate() noexcept {
       static_cast<double>(read_to_write_.percentile_ns(0.5)) / 1e3,
       static_cast<double>(read_to_write_.percentile_ns(0.99)) / 1e3,
       static_cast<double>(read_to_write_.max_ns()) / 1e3,
-      static_cast<long long>(read_to_write_.count()), static_cast<unsigned long long>(c.reads),
+      static_cast<long long>(read_to_write_.count()),
+      static_cast<double>(tx_latency_.percentile_ns(0.5)) / 1e3,
+      static_cast<double>(tx_latency_.percentile_ns(0.99)) / 1e3,
+      static_cast<double>(tx_latency_.max_ns()) / 1e3, static_cast<unsigned long long>(c.reads),
       static_cast<unsigned long long>(c.writes), static_cast<unsigned long long>(c.errors),
       static_cast<unsigned long long>(c.timeouts), static_cast<unsigned long long>(c.stale),
       static_cast<unsigned long long>(c.bad_data), static_cast<unsigned long long>(c.retries),
@@ -339,6 +392,7 @@ CanCounters CanDriver::can_counters() const noexcept {
   c.error_frames = n_.error_frames.load(std::memory_order_relaxed);
   c.tx_frames = n_.writes.load(std::memory_order_relaxed);
   c.command_saturated = n_.saturated.load(std::memory_order_relaxed);
+  c.commands_superseded = n_.superseded.load(std::memory_order_relaxed);
   return c;
 }
 

@@ -100,8 +100,9 @@ std::vector<std::string> ModbusConfig::problems() const {
             " must be 0 (the loop's rate) or within [1, 100000]");
   check(priority >= 0 && priority <= 99,
         "priority: " + std::to_string(priority) + " must be 0 (normal) or within [1, 99]");
-  check(stale_reads >= 0 && stale_reads <= 1000,
-        "stale_reads: " + std::to_string(stale_reads) + " must be within [0, 1000]");
+  check(max_age_s == 0.0 || (max_age_s >= 1e-5 && max_age_s <= sample_timeout_s),
+        "max_age_s: " + number(max_age_s) +
+            " must be 0 (2.5 poll periods) or within [0.00001, sample_timeout_s]");
   check(sample_timeout_s > 0.0 && sample_timeout_s <= 10.0,
         "sample_timeout_s: " + number(sample_timeout_s) + " must be within (0, 10]");
   check(reconnect_min_s > 0.0 && reconnect_min_s <= reconnect_max_s && reconnect_max_s <= 60.0,
@@ -142,7 +143,7 @@ void read_modbus_section(io::YamlMap& driver, Transport transport, ModbusConfig&
   driver.read("byte_timeout_s", out.byte_timeout_s);
   driver.read("poll_rate_hz", out.poll_rate_hz);
   driver.read("priority", out.priority);
-  driver.read("stale_reads", out.stale_reads);
+  driver.read("max_age_s", out.max_age_s);
   driver.read("sample_timeout_s", out.sample_timeout_s);
   if (auto r = driver.optional_map("reconnect")) {
     r->read("min_s", out.reconnect_min_s);

@@ -9,7 +9,7 @@
 //   response_timeout_s: 0.02   byte_timeout_s: 0.005
 //   poll_rate_hz: 0            bus polls per second; 0: the loop's rate
 //   priority: 0                the bus thread's SCHED_FIFO priority (1..99); 0: normal
-//   stale_reads: 2             repeated samples answered with the held one before kStale
+//   max_age_s: 0               the held sample older than this: kStale; 0: 2.5 poll periods
 //   sample_timeout_s: 0.02     a sample older than this: kTimeout
 //   reconnect: {min_s: 0.01, max_s: 1.0, after_failures: 3}
 //   registers: {e: {...}, d: {...}, s_ref, t_ref, status, command}  (absent: the default map)
@@ -42,7 +42,7 @@ struct ModbusConfig {
   double byte_timeout_s{0.005};
   double poll_rate_hz{0.0};  // 0: the loop's rate
   int priority{0};           // bus thread SCHED_FIFO priority; 0: normal scheduling
-  int stale_reads{2};
+  double max_age_s{0.0};     // 0: 2.5 poll periods (two polls missed)
   double sample_timeout_s{0.02};
   double reconnect_min_s{0.01};
   double reconnect_max_s{1.0};

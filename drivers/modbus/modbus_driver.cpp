@@ -69,6 +69,8 @@ bool ModbusDriver::configure(const runtime::DriverSetup& setup, std::string* why
   const double rate = config_.poll_rate_hz > 0.0 ? config_.poll_rate_hz : 1.0 / setup.sample_time;
   period_ns_ = std::llround(1e9 / rate);
   sample_timeout_ns_ = std::llround(config_.sample_timeout_s * 1e9);
+  max_age_ns_ =
+      config_.max_age_s > 0.0 ? std::llround(config_.max_age_s * 1e9) : period_ns_ * 5 / 2;
   blocks_ = {};
   for (const RegisterSpec* spec : config_.registers.inputs()) {
     if (!spec->enabled) continue;
@@ -116,7 +118,6 @@ bool ModbusDriver::activate(std::string* why) {
   const auto [bs, bus] = split_seconds(config_.byte_timeout_s);
   modbus_set_byte_timeout(ctx_, bs, bus);
   held_ = Sample{};
-  repeats_ = 0;
   command_seq_ = 0;
   written_seq_ = 0;
   published_seq_ = 0;
@@ -159,20 +160,16 @@ runtime::DriverStatus ModbusDriver::read(runtime::InputSample& out) noexcept {
   if (!active_) return runtime::DriverStatus::kNotActive;
   bump(reads_);
   Sample s;
-  if (samples_.try_read(s) && s.seq != held_.seq && s.seq != 0) {
-    held_ = s;
-    repeats_ = 0;
-  } else {
-    ++repeats_;
-    bump(stale_);
-  }
+  if (samples_.try_read(s) && s.seq != held_.seq && s.seq != 0) held_ = s;
   out = held_.in;
   if (!connected_.load(std::memory_order_acquire)) return runtime::DriverStatus::kDisconnected;
-  if (held_.seq == 0 || now_ns() - held_.received_ns > sample_timeout_ns_) {
-    return runtime::DriverStatus::kTimeout;
-  }
+  const std::int64_t age = now_ns() - held_.received_ns;
+  if (held_.seq == 0 || age > sample_timeout_ns_) return runtime::DriverStatus::kTimeout;
   if (held_.bad) return runtime::DriverStatus::kBadData;
-  if (repeats_ > config_.stale_reads) return runtime::DriverStatus::kStale;
+  if (age > max_age_ns_) {
+    bump(stale_);
+    return runtime::DriverStatus::kStale;
+  }
   return runtime::DriverStatus::kOk;
 }
 

@@ -16,9 +16,11 @@
 //   kDisconnected  no link to the device (the bus thread reconnects with back-off)
 //   kTimeout       the newest sample is older than sample_timeout_s, or none has arrived
 //   kBadData       a value decoded to NaN/infinity or outside its register's range
-//   kStale         no new sample for more than stale_reads reads in a row (each repeat counts
-//                  in counters().stale; up to stale_reads repeats are answered kOk with the
-//                  held sample, like a zero-order hold across bus jitter)
+//   kStale         the held sample is older than max_age_s (by its timestamp, the end of the
+//                  poll that read it; younger samples are answered kOk even when read again, a
+//                  zero-order hold across bus jitter; each kStale counts in counters().stale).
+//                  Age, not a count of reads: a loop that wakes late and runs a burst of cycles
+//                  does not use up an allowance.
 //   kOk            otherwise
 // write() (real-time safe) hands the command over; kDisconnected while there is no link.
 //
@@ -133,6 +135,7 @@ class ModbusDriver final : public runtime::Driver {
   ModbusConfig config_;
   std::int64_t period_ns_{0};
   std::int64_t sample_timeout_ns_{0};
+  std::int64_t max_age_ns_{0};
   _modbus* ctx_{nullptr};
   std::thread bus_{};
   std::atomic<bool> stop_{false};
@@ -145,7 +148,6 @@ class ModbusDriver final : public runtime::Driver {
 
   // Loop thread only.
   Sample held_{};
-  int repeats_{0};
   std::uint64_t command_seq_{0};
 
   // Bus thread only.

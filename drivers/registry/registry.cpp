@@ -8,6 +8,7 @@
 #include "selfsense/io/yaml_map.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
 #include "sim/simulated_transducer.hpp"
+#include "spi/spi_driver.hpp"
 
 namespace selfsense::drivers {
 namespace {
@@ -45,7 +46,7 @@ void read_simulated(io::YamlMap& driver, const daemon::DaemonConfig& config,
 }  // namespace
 
 std::string driver_types() {
-  return "simulated, can, modbus-tcp, modbus-rtu";
+  return "simulated, can, modbus-tcp, modbus-rtu, spi";
 }
 
 void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
@@ -61,6 +62,8 @@ void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
     modbus::read_modbus_section(
         driver, type_ == "modbus-tcp" ? modbus::Transport::kTcp : modbus::Transport::kRtu, modbus_,
         problems);
+  } else if (type_ == "spi") {
+    spi::read_spi_config(driver, config.loop.rate_hz, spi_, problems);
   } else {
     problems.push_back(
         driver.locate("driver.type: '" + type_ + "' is not one of " + driver_types()));
@@ -71,6 +74,7 @@ void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
 std::unique_ptr<runtime::Driver> Registry::create() const {
   if (!ok_) throw std::logic_error("driver registry: no valid driver section was read");
   if (type_ == "can") return std::make_unique<can::CanDriver>(can_);
+  if (type_ == "spi") return std::make_unique<spi::SpiDriver>(spi_);
   if (type_ == "modbus-tcp" || type_ == "modbus-rtu") {
     return std::make_unique<modbus::ModbusDriver>(modbus_);
   }

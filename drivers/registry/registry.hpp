@@ -8,6 +8,8 @@
 //     interface, fd, rx_timeout_ms, stale_cycles, error_frames, signals: {e, d, s_ref, t_ref,
 //     command}          see drivers/can/can_config.hpp
 //   type: modbus-tcp | modbus-rtu   the Modbus driver (drivers/modbus, docs/drivers/modbus.md)
+//   type: spi           ADS131M04 ADC + DAC8563 DAC on spidev, GPIO on libgpiod (drivers/spi,
+//                       docs/drivers/spi.md; keys in drivers/spi/spi_config.hpp)
 #pragma once
 
 #include <memory>
@@ -19,10 +21,11 @@
 #include "selfsense/daemon/config.hpp"
 #include "selfsense/plant/config.hpp"
 #include "selfsense/runtime/driver.hpp"
+#include "spi/spi_config.hpp"
 
 namespace selfsense::drivers {
 
-// Every driver type, for messages: "simulated, can, modbus-tcp, modbus-rtu".
+// Every driver type, for messages: "simulated, can, modbus-tcp, modbus-rtu, spi".
 [[nodiscard]] std::string driver_types();
 
 class Registry final : public daemon::DriverSectionReader {
@@ -33,6 +36,9 @@ class Registry final : public daemon::DriverSectionReader {
   [[nodiscard]] std::unique_ptr<runtime::Driver> create() const;
   // The CAN section read last (driver.type can), for `selfsense sim-device --can`.
   [[nodiscard]] const can::CanConfig& can_config() const noexcept { return can_; }
+  // The SPI section read last (driver.type spi), for tests and benches that build the driver
+  // on emulated hardware.
+  [[nodiscard]] const spi::SpiConfig& spi_config() const noexcept { return spi_; }
 
  private:
   std::string type_{};
@@ -40,6 +46,7 @@ class Registry final : public daemon::DriverSectionReader {
   plant::PlantConfig plant_{};
   can::CanConfig can_{};
   modbus::ModbusConfig modbus_{};
+  spi::SpiConfig spi_{};
 };
 
 }  // namespace selfsense::drivers

@@ -73,7 +73,7 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
                                           std::move(reconstruction), controller, sink_.get());
   runner_ = std::make_unique<runtime::LoopRunner>(
       *loop_, clock_, std::llround(ts * 1e9),
-      runtime::RtOptions{config_.loop.priority, config_.loop.cpu});
+      runtime::RtOptions{config_.loop.priority, config_.loop.cpu}, driver_->cycle_trigger());
 }
 
 Daemon::~Daemon() {

@@ -4,8 +4,9 @@
 
 namespace selfsense::runtime {
 
-LoopRunner::LoopRunner(Loop& loop, Clock& clock, std::int64_t period_ns, const RtOptions& rt)
-    : loop_(&loop), clock_(&clock), period_ns_(period_ns), rt_(rt) {}
+LoopRunner::LoopRunner(Loop& loop, Clock& clock, std::int64_t period_ns, const RtOptions& rt,
+                       CycleTrigger* trigger)
+    : loop_(&loop), clock_(&clock), period_ns_(period_ns), rt_(rt), trigger_(trigger) {}
 
 LoopRunner::~LoopRunner() {
   stop();
@@ -36,17 +37,28 @@ void LoopRunner::run() {
   }
   setup_cv_.notify_all();
   pacer.start();
+  std::int64_t cycle = 0;
+  std::int64_t late = 0;  // triggered cycles that started late
   while (!stop_.load(std::memory_order_relaxed)) {
-    const Pacer::Tick tick = pacer.wait();
+    bool overrun = false;
+    if (trigger_ != nullptr) {
+      overrun = !wait_trigger();
+      if (overrun) ++late;
+      ++cycle;
+    } else {
+      const Pacer::Tick tick = pacer.wait();
+      overrun = tick.overrun;
+      cycle = tick.cycle;
+    }
     if (stall_.load(std::memory_order_relaxed)) continue;
     const std::int64_t begin = clock_->now_ns();
-    loop_->cycle(tick.overrun);
+    loop_->cycle(overrun);
     cycle_stats.record(clock_->now_ns() - begin);
     progress_.fetch_add(1, std::memory_order_relaxed);
-    if (tick.cycle % 1000 == 0) {
+    if (cycle % 1000 == 0) {
       const PacerStats& p = pacer.stats();
-      timing.overruns = p.overruns;
-      timing.missed_periods = p.missed_periods;
+      timing.overruns = trigger_ != nullptr ? late : p.overruns;
+      timing.missed_periods = trigger_ != nullptr ? late : p.missed_periods;
       timing.last_overrun_cycle = p.last_overrun_cycle;
       timing.wake_latency_p50_ns = p.wake_latency.percentile_ns(0.5);
       timing.wake_latency_p99_ns = p.wake_latency.percentile_ns(0.99);
@@ -57,6 +69,16 @@ void LoopRunner::run() {
       loop_->set_timing(timing);
     }
   }
+}
+
+bool LoopRunner::wait_trigger() noexcept {
+  const CycleTrigger::Result r = trigger_->wait(2 * period_ns_);
+  if (r == CycleTrigger::Result::kError) {
+    // The line cannot be waited on: one period of sleep keeps the loop from spinning while
+    // its cycles report the fault.
+    clock_->sleep_until_ns(clock_->now_ns() + period_ns_);
+  }
+  return r == CycleTrigger::Result::kReady;
 }
 
 }  // namespace selfsense::runtime

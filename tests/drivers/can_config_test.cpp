@@ -129,6 +129,18 @@ TEST(CanConfig, FdAllowsSixtyFourByteFrames) {
   EXPECT_EQ(fd.can_config().frame_length(9), 12U);
 }
 
+TEST(CanConfig, TheBusThreadPriorityIsChecked) {
+  Registry registry;
+  const ConfigResult ok = load_with({{"  priority: 70 ", "  priority: 0 "}}, registry);
+  ASSERT_TRUE(ok.ok()) << joined(ok);
+  EXPECT_EQ(registry.can_config().priority, 0);
+  Registry bad;
+  const ConfigResult r = load_with({{"  priority: 70 ", "  priority: 120 "}}, bad);
+  EXPECT_NE(joined(r).find("driver.priority: 120 must be 0 (normal) or within [1, 99]"),
+            std::string::npos)
+      << joined(r);
+}
+
 TEST(CanDriver, WithoutActivationNothingHappens) {
   Registry registry;
   ASSERT_TRUE(load_config(kConfigDir / "can-sim.yaml", &registry).ok());

@@ -18,6 +18,8 @@
 #include <string>
 #include <string_view>
 
+#include "selfsense/runtime/cycle_trigger.hpp"
+
 namespace selfsense::runtime {
 
 enum class DriverStatus : std::uint8_t {
@@ -82,6 +84,9 @@ class Driver {
   // Whether read() fills s_ref and t_ref.
   [[nodiscard]] virtual bool has_references() const noexcept { return false; }
   [[nodiscard]] virtual DriverCounters counters() const noexcept = 0;
+  // When the device paces the loop (its data-ready edge starts each cycle), the trigger to wait
+  // on instead of the timer; null otherwise (the default). Valid while the driver is active.
+  [[nodiscard]] virtual CycleTrigger* cycle_trigger() noexcept { return nullptr; }
 };
 
 }  // namespace selfsense::runtime

@@ -1,5 +1,8 @@
 // The real-time thread: real-time set-up once, then the loop paced to absolute deadlines
-// (Pacer on CLOCK_MONOTONIC), each cycle's execution time and wake-up latency measured and
+// (Pacer on CLOCK_MONOTONIC), or, when the driver offers a CycleTrigger (an ADC's data-ready
+// edge), to the trigger: each cycle starts when it fires, and a trigger that does not fire within
+// two periods counts as an overrun and the cycle runs anyway (its read() reports the missing
+// sample, the supervisor faults). Each cycle's execution time and wake-up latency are measured and
 // published with the loop's status. progress() counts finished cycles: the daemon pings the
 // systemd watchdog only while it advances, so a stalled loop gets the service restarted.
 //
@@ -13,6 +16,7 @@
 #include <mutex>
 #include <thread>
 
+#include "selfsense/runtime/cycle_trigger.hpp"
 #include "selfsense/runtime/loop.hpp"
 #include "selfsense/runtime/pacer.hpp"
 #include "selfsense/runtime/rt_setup.hpp"
@@ -21,7 +25,9 @@ namespace selfsense::runtime {
 
 class LoopRunner final {
  public:
-  LoopRunner(Loop& loop, Clock& clock, std::int64_t period_ns, const RtOptions& rt);
+  // trigger: null for the pacer; otherwise the driver's (valid while the runner runs).
+  LoopRunner(Loop& loop, Clock& clock, std::int64_t period_ns, const RtOptions& rt,
+             CycleTrigger* trigger = nullptr);
   LoopRunner(const LoopRunner&) = delete;
   LoopRunner& operator=(const LoopRunner&) = delete;
   LoopRunner(LoopRunner&&) = delete;
@@ -39,11 +45,14 @@ class LoopRunner final {
 
  private:
   void run();
+  // One wait for the trigger; false when the cycle starts late (timeout or line error).
+  bool wait_trigger() noexcept;
 
   Loop* loop_;
   Clock* clock_;
   std::int64_t period_ns_;
   RtOptions rt_;
+  CycleTrigger* trigger_;
   std::thread thread_{};
   std::atomic<bool> stop_{false};
   std::atomic<bool> stall_{false};

@@ -34,7 +34,7 @@ start_device 0
 # CI runs other real-time tests on the same cores: a late wake-up makes the loop catch up with a
 # burst of cycles that finds no new samples, so the staleness allowance is wider than shipped.
 sed -e "s|port: 1502|port: $port|" \
-  -e "s|stale_reads: 10 |stale_reads: 50 |" -e "s|sample_timeout_s: 0.05 |sample_timeout_s: 0.1 |" \
+  -e "s|max_age_s: 0.005 |max_age_s: 0.05 |" -e "s|sample_timeout_s: 0.05 |sample_timeout_s: 0.1 |" \
   -e "s|directory: ../build/modbus-sim/recordings|directory: $out/recordings|" \
   -e "s|path: ../build/modbus-sim/control.sock|path: $out/control.sock|" \
   -e "s|prometheus_file: ../build/modbus-sim/selfsensed.prom|prometheus_file: $out/selfsensed.prom|" \
