@@ -106,5 +106,32 @@ TEST(YamlMap, ParseErrorsAndNonMappingDocuments) {
             "/nonexistent/x.yaml: cannot open the file");
 }
 
+// Found by fuzzing (tests/fuzz/corpus/daemon_config/regression-*): a YAML escape, a quoted
+// value or a key with a line break made a problem of two lines out of one.
+TEST(YamlMap, EveryErrorIsOneLine) {
+  // yaml-cpp names an unknown escape by its raw byte.
+  EXPECT_EQ(error_of([] { static_cast<void>(YamlMap::from_string("a: \"x\\\x1d\"\n", "C.yaml")); }),
+            "C.yaml:1: unknown escape character: \\x1d");
+  EXPECT_EQ(error_of([] {
+              YamlMap root = YamlMap::from_string("n: \"1\\n2\\t\\e\"\n", "C.yaml");
+              static_cast<void>(root.required<int>("n"));
+            }),
+            "C.yaml:1: n: expected an integer, got '1\\n2\\t\\x1b'");
+  EXPECT_EQ(error_of([] {
+              YamlMap root = YamlMap::from_string("\"bad\\nkey\": 1\n", "C.yaml");
+              root.finish();
+            }),
+            "C.yaml:1: bad\\nkey: unknown key");
+  YamlMap root = YamlMap::from_string("a: 1\n", "C.yaml");
+  EXPECT_EQ(root.locate("driver.type: 'x\ny' is not a type"),
+            "C.yaml: driver.type: 'x\\ny' is not a type");
+  const std::string long_value(100, 'v');
+  EXPECT_EQ(error_of([&] {
+              YamlMap map = YamlMap::from_string("n: " + long_value + "\n", "C.yaml");
+              static_cast<void>(map.required<int>("n"));
+            }),
+            "C.yaml:1: n: expected an integer, got '" + long_value.substr(0, 64) + "...'");
+}
+
 }  // namespace
 }  // namespace selfsense::io
