@@ -225,7 +225,24 @@ std::string YamlMap::locate(const std::string& message) const {
       line = key_line;
     }
   }
-  if (best.empty()) return one_line(context_->source + ": " + message);
+  if (best.empty()) {
+    // A key left at its default stands on no line: name the line of another key the message
+    // names ("... must be inside control.command_v_per_m"), else the document's first line.
+    line = 1;
+    const auto boundary = [&](std::size_t at) {
+      return at >= message.size() ||
+             std::string_view(" :[.,;)'").find(message[at]) != std::string_view::npos;
+    };
+    for (const auto& [key, key_line] : context_->lines) {
+      for (auto at = message.find(key); at != std::string::npos; at = message.find(key, at + 1)) {
+        if (at > 0 && message[at - 1] == ' ' && boundary(at + key.size()) &&
+            key.size() > best.size()) {
+          best = key;
+          line = key_line;
+        }
+      }
+    }
+  }
   return one_line(context_->source + ":" + std::to_string(line) + ": " + message);
 }
 

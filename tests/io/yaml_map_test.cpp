@@ -92,7 +92,23 @@ TEST(YamlMap, LocateAddsTheLineOfAKeyReadEarlier) {
   YamlMap y = plant.map("y");
   static_cast<void>(y.required<int>("z"));
   EXPECT_EQ(root.locate("plant.y.z: 5: too large"), "C.yaml:4: plant.y.z: 5: too large");
-  EXPECT_EQ(root.locate("other: bad"), "C.yaml: other: bad");
+  EXPECT_EQ(root.locate("other: bad"), "C.yaml:1: other: bad");
+}
+
+// Found by fuzzing (tests/fuzz/corpus/daemon_config/regression-default-*): a problem with a key
+// left at its default named no line, against check-config's `FILE:LINE: KEY.PATH: what`.
+TEST(YamlMap, LocateGivesADefaultKeyTheLineOfTheKeyItConflictsWith) {
+  YamlMap root = YamlMap::from_string("a: 1\ncontrol:\n  range: [1, 2]\n", "C.yaml");
+  YamlMap control = root.map("control");
+  std::vector<double> range;
+  control.read_sequence("range", range);
+  EXPECT_EQ(root.locate("safety.value: must be inside control.range"),
+            "C.yaml:3: safety.value: must be inside control.range");
+  // The section, when the key itself is not in the file either; else the document.
+  EXPECT_EQ(root.locate("safety.value: must be inside control.ranges"),
+            "C.yaml:2: safety.value: must be inside control.ranges");
+  EXPECT_EQ(root.locate("safety.value: must be positive"),
+            "C.yaml:1: safety.value: must be positive");
 }
 
 TEST(YamlMap, ParseErrorsAndNonMappingDocuments) {
@@ -124,7 +140,7 @@ TEST(YamlMap, EveryErrorIsOneLine) {
             "C.yaml:1: bad\\nkey: unknown key");
   YamlMap root = YamlMap::from_string("a: 1\n", "C.yaml");
   EXPECT_EQ(root.locate("driver.type: 'x\ny' is not a type"),
-            "C.yaml: driver.type: 'x\\ny' is not a type");
+            "C.yaml:1: driver.type: 'x\\ny' is not a type");
   const std::string long_value(100, 'v');
   EXPECT_EQ(error_of([&] {
               YamlMap map = YamlMap::from_string("n: " + long_value + "\n", "C.yaml");

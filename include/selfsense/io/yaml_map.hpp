@@ -98,7 +98,8 @@ class YamlMap final {
 
   // Prefixes "file:line: " to a message that starts with a key path read through any map of this
   // document ("plant.mechanics.resonance_hz: ..."), for validation errors found after loading.
-  // The result is one line, like every error.
+  // A key path in no line of the file (a default) takes the line of another key path the message
+  // names, else line 1. The result is one line, like every error.
   [[nodiscard]] std::string locate(const std::string& message) const;
   [[nodiscard]] const std::string& source() const noexcept { return context_->source; }
 
