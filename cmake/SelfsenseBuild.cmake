@@ -16,6 +16,20 @@ if(SELFSENSE_SANITIZE)
   endif()
 endif()
 
+# libFuzzer (tests/fuzz, docs/reliability.md): every library is built with the fuzzer's coverage
+# instrumentation (-fsanitize=fuzzer-no-link), the fuzz targets link libFuzzer's main. The
+# instrumentation's hooks come from the sanitizer runtimes, hence a sanitizer is required.
+if(SELFSENSE_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "SELFSENSE_FUZZ=ON needs clang (libFuzzer); configure with CXX=clang++")
+  endif()
+  if(NOT SELFSENSE_SANITIZE)
+    message(FATAL_ERROR "SELFSENSE_FUZZ=ON needs SELFSENSE_SANITIZE (e.g. address,undefined)")
+  endif()
+  target_compile_options(selfsense_build_flags INTERFACE -fsanitize=fuzzer-no-link)
+  target_link_options(selfsense_build_flags INTERFACE -fsanitize=fuzzer-no-link)
+endif()
+
 # Registers a target for installation in the selfsense export set.
 function(selfsense_export target)
   set_property(GLOBAL APPEND PROPERTY SELFSENSE_EXPORTED_TARGETS ${target})

@@ -6,7 +6,8 @@
 #   scripts/setup.sh demo   install, build (Release), run the main job (the daemon on the
 #                           simulated transducer; before it the operator demo and self-sensing)
 #   scripts/setup.sh test   install, format check, build (Release, -Werror), unit tests,
-#                           clang-tidy, then build and test again under ASan + UBSan
+#                           clang-tidy, then build (clang) and test again under ASan + UBSan
+#                           and run every fuzz target for a bounded time
 set -euo pipefail
 
 mode=${1:-demo}
@@ -22,6 +23,7 @@ packages=(
   nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy
+  clang libclang-rt-14-dev  # the sanitizer build and the fuzz targets (libFuzzer), tests/fuzz
   zlib1g-dev chromium fonts-liberation  # the diagnosis report's browser test (tests/cli)
   mbpoll
 )
@@ -93,6 +95,25 @@ run_self_sensing() {
     --out "$out/reconstructed.csv"
 }
 
+# Every fuzz target (tests/fuzz, docs/reliability.md) for FUZZ_SECONDS (default 10) with a
+# fixed seed, on a scratch copy of its committed corpus (the repository's corpus is never
+# written). A violated property, a sanitizer report, a timeout or a leak fails the run; the
+# input is kept as DIR/fuzz-<target>-crash-... and the log's tail is printed.
+run_fuzz() {
+  local dir=$1 seconds=${FUZZ_SECONDS:-10} scratch name log
+  scratch=$(mktemp -d)
+  for corpus in tests/fuzz/corpus/*/; do
+    name=$(basename "$corpus")
+    log="$dir/fuzz-$name.log"
+    cp -r "$corpus" "$scratch/$name"
+    "$dir/tests/fuzz/fuzz_$name" -seed=1 -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+      -print_final_stats=1 -artifact_prefix="$dir/fuzz-$name-" "$scratch/$name" >"$log" 2>&1 ||
+      { tail -40 "$log"; rm -rf "$scratch"; echo "fuzz: $name failed (input kept as $dir/fuzz-$name-*)" >&2; exit 1; }
+    printf 'fuzz: %-16s %s\n' "$name" "$(grep -E '^#[0-9]+' "$log" | tail -1 | sed 's/  */ /g')"
+  done
+  rm -rf "$scratch"
+}
+
 # The tests under a real kernel and systemd (tests/vm, docs/vm-testing.md): builds the cached
 # VM image unless present (as root; a few minutes once, then instant), then boots it once for
 # every VM test. Needs a configured build directory (the tests are CTest tests).
@@ -132,10 +153,18 @@ case "$mode" in
     run_tests build -LE vm
     run_vm_tests build
     check_tidy
-    configure_and_build build-sanitize -DCMAKE_BUILD_TYPE=Debug -DSELFSENSE_WERROR=ON \
-      -DSELFSENSE_SANITIZE=address,undefined -DSELFSENSE_BUILD_BENCHMARKS=OFF
+    # clang, so that the same build also links the fuzz targets with libFuzzer; a directory
+    # configured with another compiler is started afresh (CMake keeps the compiler it found).
+    if [ -f build-sanitize/CMakeCache.txt ] &&
+      ! grep -q '^CMAKE_CXX_COMPILER:[A-Z]*=.*clang++' build-sanitize/CMakeCache.txt; then
+      rm -rf build-sanitize
+    fi
+    CXX=clang++ configure_and_build build-sanitize -DCMAKE_BUILD_TYPE=Debug -DSELFSENSE_WERROR=ON \
+      -DSELFSENSE_SANITIZE=address,undefined -DSELFSENSE_BUILD_BENCHMARKS=OFF -DSELFSENSE_FUZZ=ON
     # The accuracy figures are checked in the Release run; under the sanitizers they only cost time.
     run_tests build-sanitize -LE 'accuracy|vm'
+    say "fuzz: every target for ${FUZZ_SECONDS:-10} s on a copy of its corpus"
+    run_fuzz build-sanitize
     run_thread_sanitizer
     say "all checks passed"
     ;;

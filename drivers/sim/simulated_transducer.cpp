@@ -46,6 +46,8 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
   ++counters_.reads;
   const plant::StepInput input{command_, force_n_.load(std::memory_order_relaxed), 25.0};
   plant::StepOutput o{};
+  // The plant may run several steps per loop cycle; a fault flag raised in any of them is the
+  // device's (like the sticky bits of a status register), not only one in the step read last.
   std::uint32_t status = 0;
   for (int i = 0; i < substeps_; ++i) {
     o = plant_->step(input);
@@ -57,16 +59,16 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
   out.s_ref = o.s;
   out.t_ref = o.t_pa;
   out.timestamp_ns = static_cast<std::int64_t>(std::llround(o.t_s * 1e9));
-  out.device_status = static_cast<std::uint16_t>(o.status & 0xffffU);
-  if ((o.status & plant::kAmplifierFault) != 0U) {
+  out.device_status = static_cast<std::uint16_t>(status & 0xffffU);
+  if ((status & plant::kAmplifierFault) != 0U) {
     ++counters_.device_faults;
     return runtime::DriverStatus::kDeviceFault;
   }
-  if ((o.status & (plant::kStuckAdc | plant::kMissedDataReady)) != 0U) {
+  if ((status & (plant::kStuckAdc | plant::kMissedDataReady)) != 0U) {
     ++counters_.stale;
     return runtime::DriverStatus::kStale;
   }
-  if ((o.status & (plant::kNanSample | plant::kOutOfRange | plant::kSensorDisconnect)) != 0U) {
+  if ((status & (plant::kNanSample | plant::kOutOfRange | plant::kSensorDisconnect)) != 0U) {
     ++counters_.bad_data;
     return runtime::DriverStatus::kBadData;
   }

@@ -8,9 +8,10 @@
 // external force, and returns the last substep's measured E and D, with the true S and T as
 // reference channels.
 //
-// Faults: a plant status bit becomes a driver status: stuck ADC and missed data-ready -> kStale,
-// NaN, out-of-range and disconnected channels -> kBadData (the values are passed on too, so the
-// loop's own checks see them), amplifier fault line -> kDeviceFault.
+// Faults: a plant status bit raised in any of the cycle's plant samples becomes a driver
+// status: stuck ADC and missed data-ready -> kStale, NaN, out-of-range and disconnected
+// channels -> kBadData (the values are passed on too, so the loop's own checks see them),
+// amplifier fault line -> kDeviceFault.
 //
 // read(), write(), inject(), set_external_force() are real-time safe.
 #pragma once

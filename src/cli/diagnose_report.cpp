@@ -319,14 +319,8 @@ std::string correlation_plot(const ReportCorrelation& c, bool cross, std::string
   plot.add_stems(std::string(which), lags, values, std::string(colour));
   const double bound = std::abs(c.bound);
   if (bound > 0.0) {
-    plot.add_reference(
-        "\xC2\xB1"
-        "bound (99 %)",
-        bound, std::string(kBoundColour));
-    plot.add_reference(
-        "\xC2\xB1"
-        "bound (99 %)",
-        -bound, std::string(kBoundColour));
+    plot.add_reference(std::string(kBoundLabel), bound, std::string(kBoundColour));
+    plot.add_reference(std::string(kBoundLabel), -bound, std::string(kBoundColour));
   }
   std::string caption;
   if (!values.empty()) {

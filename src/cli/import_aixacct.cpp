@@ -1,6 +1,7 @@
 #include "import_aixacct.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <map>
 #include <string_view>
@@ -216,6 +217,17 @@ AixacctImport import_aixacct(const std::filesystem::path& path, const AixacctOpt
   rec.set_column("I", raw.i);
   rec.set_column("P1", raw.p);
   rec.set_column("D1", raw.x);
+  // Finite cells can still give a value beyond the range of a double (V+ - V-, / h); a
+  // recording holds finite numbers only. Row k is line header + 2 + k (1-based).
+  for (std::size_t j = 0; j < rec.cols(); ++j) {
+    const auto c = rec.column(j);
+    const auto bad = std::find_if(c.begin(), c.end(), [](double v) { return !std::isfinite(v); });
+    if (bad == c.end()) continue;
+    const auto k = static_cast<std::size_t>(bad - c.begin());
+    throw io::RecordingError(at(file, block->header + 2 + k) + "column '" + rec.names()[j] +
+                             "': " + format_number(*bad) + " after conversion (" + rec.comments[1] +
+                             ", h = " + format_number(h) + " m)");
+  }
   return out;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <optional>
 #include <stdexcept>
 #include <system_error>
@@ -21,13 +22,23 @@ std::string where(const std::string& file, std::size_t line, const ColumnMap& m)
 }
 
 // Appends `field` = `terminal` / `divisor` when the terminal column exists, the field one does
-// not and the divisor (a geometry length or area) was given.
+// not and the divisor (a geometry length or area) was given. Row k came from line first_line + k;
+// a quotient beyond the range of a double is an error naming it (a recording holds finite
+// numbers only).
 void convert(io::Recording& rec, const char* terminal, const char* field, double divisor,
-             const char* what) {
+             const char* what, const std::string& file, std::size_t first_line) {
   if (divisor <= 0.0 || !rec.has(terminal) || rec.has(field)) return;
   const auto c = rec.column(terminal);
   std::vector<double> out(c.size());
   std::transform(c.begin(), c.end(), out.begin(), [divisor](double v) { return v / divisor; });
+  const auto bad = std::find_if(out.begin(), out.end(), [](double v) { return !std::isfinite(v); });
+  if (bad != out.end()) {
+    const auto k = static_cast<std::size_t>(bad - out.begin());
+    throw io::RecordingError(file + ":" + std::to_string(first_line + k) + ": " + field + " = " +
+                             terminal + " / " + format_number(divisor) + " = " +
+                             format_number(c[k]) + " / " + format_number(divisor) +
+                             " is beyond the range of a double");
+  }
   rec.set_column(field, std::move(out));
   rec.comments.push_back(std::string(field) + " = " + terminal + " / " + format_number(divisor) +
                          " (" + what + ")");
@@ -108,7 +119,12 @@ io::Recording import_columns(const std::filesystem::path& path, const ColumnsOpt
         throw io::RecordingError(where(file, j + 1, m) + "not a number: '" +
                                  std::string(trim(cells[m.column - 1])) + "'");
       }
-      values[i].push_back(*v * m.factor);
+      const double si = *v * m.factor;
+      if (!std::isfinite(si)) {
+        throw io::RecordingError(where(file, j + 1, m) + format_number(*v) + " " + m.unit +
+                                 " is beyond the range of a double in SI units");
+      }
+      values[i].push_back(si);
       if (i == t_index && values[i].size() > 1 && values[i].back() <= values[i].end()[-2]) {
         throw io::RecordingError(where(file, j + 1, m) + format_number(*v) + " does not increase");
       }
@@ -132,11 +148,12 @@ io::Recording import_columns(const std::filesystem::path& path, const ColumnsOpt
                            format_number(map[i].factor));
     rec.set_column(map[i].name, std::move(values[i]));
   }
-  convert(rec, "u", "E", options.layer_thickness_m, "layer thickness [m]");
+  const std::size_t line = first + 1;  // of the first row
+  convert(rec, "u", "E", options.layer_thickness_m, "layer thickness [m]", file, line);
   convert(rec, "q", "D", options.electrode_area_m2 * options.layers,
-          "electrode area [m^2] * layers");
-  convert(rec, "x", "S", options.active_length_m, "active length [m]");
-  convert(rec, "F", "T", options.cross_section_m2, "mechanical cross-section [m^2]");
+          "electrode area [m^2] * layers", file, line);
+  convert(rec, "x", "S", options.active_length_m, "active length [m]", file, line);
+  convert(rec, "F", "T", options.cross_section_m2, "mechanical cross-section [m^2]", file, line);
   return rec;
 }
 

@@ -370,13 +370,29 @@ Request parse_object(const json& object, const RequestLimits& limits) {
   reject("request: " + echo(kind) + " is not a request (" + joined(kRequestNames) + ")");
 }
 
-// The JSON text's own prefix ("[json.exception.parse_error.101] ") says nothing to a user.
-std::string without_prefix(const char* what) {
+// The JSON text's own prefix ("[json.exception.parse_error.101] ") says nothing to a user, and
+// the token it quotes ("last read: '...'") is the sender's bytes: cut like any echo, at a
+// character or "<U+XXXX>" boundary, so the error stays short whatever was sent.
+std::string parse_error_text(const char* what) {
   std::string text = what;
   if (!text.empty() && text.front() == '[') {
     const auto end = text.find("] ");
     if (end != std::string::npos) text.erase(0, end + 2);
   }
+  constexpr std::string_view kLastRead = "last read: '";
+  const auto open = text.find(kLastRead);
+  if (open == std::string::npos) return text;
+  const std::size_t start = open + kLastRead.size();
+  // The token ends before "'; expected ..." when the parser says what it expected.
+  auto close = text.rfind("'; expected ");
+  if (close == std::string::npos || close < start) close = text.rfind('\'');
+  if (close == std::string::npos || close < start || close - start <= kMaxEcho) return text;
+  std::size_t cut = start + kMaxEcho;
+  const auto escape = text.rfind("<U+", cut);
+  if (escape != std::string::npos && escape >= start && text.find('>', escape) >= cut) cut = escape;
+  while (cut > start && (static_cast<unsigned char>(text[cut]) & 0xC0U) == 0x80U)
+    --cut;
+  text.replace(cut, close - cut, "...");
   return text;
 }
 
@@ -460,7 +476,7 @@ ParsedRequest parse_request(std::string_view line, const RequestLimits& limits) 
   try {
     value = json::parse(line.begin(), line.end(), watch);
   } catch (const json::exception& e) {
-    return {std::nullopt, "malformed JSON: " + without_prefix(e.what())};
+    return {std::nullopt, "malformed JSON: " + parse_error_text(e.what())};
   }
   if (too_deep) {
     return {std::nullopt, "request line: nested deeper than an object of arrays of numbers"};

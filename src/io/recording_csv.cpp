@@ -86,9 +86,13 @@ std::string errno_text(int error) {
   fail(file, line, "column '" + std::string(column) + "': " + std::string(what));
 }
 
+// Appends piecewise: GCC 12 reports a false -Wrestrict for "'" + std::string(...) once inlined.
 std::string quote_text(std::string_view text) {
-  if (text.size() <= kMaxQuotedChars) return "'" + std::string(text) + "'";
-  return "'" + std::string(text.substr(0, kMaxQuotedChars)) + "...'";
+  std::string quoted(1, '\'');
+  quoted.append(text.substr(0, kMaxQuotedChars));
+  if (text.size() > kMaxQuotedChars) quoted += "...";
+  quoted += '\'';
+  return quoted;
 }
 
 std::string format_number(double value) {
@@ -198,9 +202,13 @@ std::vector<std::string> parse_header(std::string_view line, const std::string& 
                                       std::size_t line_number) {
   std::vector<std::string> names;
   for (const std::string_view cell : split_cells(line)) {
-    if (cell.empty()) {
-      fail(file, line_number,
-           "empty column name (column " + std::to_string(names.size() + 1) + " of the header)");
+    const std::string which = " (column " + std::to_string(names.size() + 1) + " of the header)";
+    if (cell.empty()) fail(file, line_number, "empty column name" + which);
+    if (is_blank(cell)) fail(file, line_number, "blank column name " + quote_text(cell) + which);
+    // A carriage return inside a line reads as a line break in other tools, and the writer
+    // refuses it: a file that could not be written back is not accepted either.
+    if (cell.find('\r') != std::string_view::npos) {
+      fail(file, line_number, "carriage return inside column name " + quote_text(cell) + which);
     }
     if (std::find(names.begin(), names.end(), cell) != names.end()) {
       fail(file, line_number, "duplicate column '" + std::string(cell) + "' in the header");
@@ -272,6 +280,9 @@ Recording read_recording_csv(const std::filesystem::path& path, const ReadOption
     const std::string_view line = next_line(pos, end);
     ++line_number;
     if (line.starts_with('#')) {
+      if (line.find('\r') != std::string_view::npos) {
+        fail(file, line_number, "carriage return inside a comment line");
+      }
       std::string_view text = line.substr(1);
       if (text.starts_with(' ')) text.remove_prefix(1);
       recording.comments.emplace_back(text);

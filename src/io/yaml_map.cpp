@@ -7,6 +7,39 @@ namespace selfsense::io {
 
 namespace {
 
+// Echoed scalars are cut so that a runaway value cannot flood the terminal.
+constexpr std::size_t kMaxEchoChars = 64;
+
+// Every message is one line (check-config prints one problem per line): line breaks, tabs and
+// other control bytes that a file may carry in keys, values or yaml-cpp's own messages are
+// written as escapes.
+std::string one_line(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\n') {
+      out += "\\n";
+    } else if (c == '\r') {
+      out += "\\r";
+    } else if (c == '\t') {
+      out += "\\t";
+    } else if (byte < 0x20U || byte == 0x7fU) {
+      constexpr std::string_view kHex = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[byte >> 4U];
+      out += kHex[byte & 0xfU];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+[[noreturn]] void raise(const std::string& message) {
+  throw YamlError{one_line(message)};
+}
+
 int line_of(const YAML::Node& node) {
   const YAML::Mark mark = node.Mark();
   return mark.line >= 0 ? mark.line + 1 : 0;
@@ -16,13 +49,15 @@ std::string describe(const YAML::Node& node) {
   if (node.IsNull()) return "null";
   if (node.IsSequence()) return "a sequence";
   if (node.IsMap()) return "a mapping";
-  return "'" + node.Scalar() + "'";
+  const std::string& scalar = node.Scalar();
+  if (scalar.size() <= kMaxEchoChars) return "'" + scalar + "'";
+  return "'" + scalar.substr(0, kMaxEchoChars) + "...'";
 }
 
 // `where` is "file:line: path".
 [[noreturn]] void type_error(const YAML::Node& node, const std::string& where,
                              const std::string& expected) {
-  throw YamlError{where + ": expected " + expected + ", got " + describe(node)};
+  raise(where + ": expected " + expected + ", got " + describe(node));
 }
 
 template <typename T>
@@ -71,10 +106,10 @@ YamlMap YamlMap::from_string(const std::string& text, const std::string& source)
   try {
     root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
-    throw YamlError{source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg};
+    raise(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   if (!root.IsMap()) {
-    throw YamlError{source + ":1: the document must be a mapping of keys to values"};
+    raise(source + ":1: the document must be a mapping of keys to values");
   }
   return YamlMap{root, "", context};
 }
@@ -84,12 +119,12 @@ YamlMap YamlMap::load_file(const std::filesystem::path& path) {
   try {
     root = YAML::LoadFile(path.string());
   } catch (const YAML::BadFile&) {
-    throw YamlError{path.string() + ": cannot open the file"};
+    raise(path.string() + ": cannot open the file");
   } catch (const YAML::ParserException& e) {
-    throw YamlError{path.string() + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg};
+    raise(path.string() + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
   }
   if (!root.IsMap()) {
-    throw YamlError{path.string() + ":1: the document must be a mapping of keys to values"};
+    raise(path.string() + ":1: the document must be a mapping of keys to values");
   }
   auto context = std::make_shared<Context>();
   context->source = path.string();
@@ -131,8 +166,7 @@ std::string YamlMap::where_item(std::string_view key, std::size_t index,
 
 void YamlMap::fail_at(const YAML::Node& node, const std::string& path,
                       const std::string& message) const {
-  throw YamlError{context_->source + ":" + std::to_string(line_of(node)) + ": " + path + ": " +
-                  message};
+  raise(context_->source + ":" + std::to_string(line_of(node)) + ": " + path + ": " + message);
 }
 
 void YamlMap::fail(std::string_view key, const std::string& message) const {
@@ -191,8 +225,25 @@ std::string YamlMap::locate(const std::string& message) const {
       line = key_line;
     }
   }
-  if (best.empty()) return context_->source + ": " + message;
-  return context_->source + ":" + std::to_string(line) + ": " + message;
+  if (best.empty()) {
+    // A key left at its default stands on no line: name the line of another key the message
+    // names ("... must be inside control.command_v_per_m"), else the document's first line.
+    line = 1;
+    const auto boundary = [&](std::size_t at) {
+      return at >= message.size() ||
+             std::string_view(" :[.,;)'").find(message[at]) != std::string_view::npos;
+    };
+    for (const auto& [key, key_line] : context_->lines) {
+      for (auto at = message.find(key); at != std::string::npos; at = message.find(key, at + 1)) {
+        if (at > 0 && message[at - 1] == ' ' && boundary(at + key.size()) &&
+            key.size() > best.size()) {
+          best = key;
+          line = key_line;
+        }
+      }
+    }
+  }
+  return one_line(context_->source + ":" + std::to_string(line) + ": " + message);
 }
 
 }  // namespace selfsense::io

@@ -19,7 +19,6 @@ control::Pid::Params limited(control::Pid::Params p, const ControllerConfig& c) 
 Controller::Controller(const ControllerConfig& config,
                        const std::optional<models::SideModel>& actuator, double sample_time)
     : config_(config),
-      ts_(sample_time),
       mode_(config.mode),
       position_(limited(config.position, config), sample_time),
       force_(limited(config.force, config), sample_time),

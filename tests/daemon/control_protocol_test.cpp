@@ -294,6 +294,19 @@ TEST(ControlProtocol, MalformedLinesAndNonObjects) {
             "request line: nested deeper than an object of arrays of numbers");
 }
 
+// Found by fuzzing (tests/fuzz/corpus/control_request/regression-*): the parser quotes the
+// token it stopped in, which was the sender's bytes at any length.
+TEST(ControlProtocol, AMalformedLineGivesAShortError) {
+  const std::string error = rejected("{" + std::string(1000, '\r') + "\x1b");
+  EXPECT_EQ(error.rfind("malformed JSON: parse error at line 1, column 1002: ", 0), 0U) << error;
+  EXPECT_LT(error.size(), 300U) << error;
+  EXPECT_NE(error.find("<U+000D><U+000D>...'; expected string literal"), std::string::npos)
+      << error;
+  const std::string word = rejected("[\"" + std::string(500, 'x'));
+  EXPECT_LT(word.size(), 300U) << word;
+  EXPECT_NE(word.find("last read: '\"" + std::string(63, 'x') + "...'"), std::string::npos) << word;
+}
+
 TEST(ControlProtocol, BinaryBytesGiveAnErrorThatStillSerialises) {
   const std::string garbage("\x00\xff\xfe{\"request\":\"st\xc3\x28tus\"}\x01", 25);
   const std::string error = rejected(garbage);

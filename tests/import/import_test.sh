@@ -100,5 +100,13 @@ expect_error "bad.csv:2: column 1 ('t'): 0 does not increase" import columns "$w
 expect_error "unknown unit 'furlong'" import columns "$work/c.csv" --map "1:t:furlong" --out "$work/x.csv"
 expect_error "name 'x' given twice" import columns "$work/c.csv" --map "1:x,2:x" --out "$work/x.csv"
 expect_error "no column is named t; give --sample-rate-hz" import columns "$work/c.csv" --skip-rows 1 --map "3:x:um" --out "$work/x.csv"
+# finite cells whose SI value is beyond the range of a double (found by the fuzz targets'
+# round-trip property: the recording could not be written)
+printf '0,1e307\n1,2\n' >"$work/big.csv"
+expect_error "big.csv:1: column 2 ('u'): 1e+307 kV is beyond the range of a double" import columns "$work/big.csv" --map "1:t:s,2:u:kV" --out "$work/x.csv"
+printf '0,1\n1,1e300\n' >"$work/big.csv"
+expect_error "big.csv:2: E = u / 1e-10 = 1e+300 / 1e-10 is beyond the range of a double" import columns "$work/big.csv" --map "1:t:s,2:u:V" --layer-thickness-m 1e-10 --out "$work/x.csv"
+sed 's/^Thickness \[nm\]: 800000/Thickness [nm]: 1e-300/' "$work/a.dat" >"$work/big.dat"
+expect_error "big.dat:15: column 'E': inf after conversion" import aixacct "$work/big.dat" --block 1 --out "$work/x.csv"
 [ ! -e "$work/x.csv" ] || fail "an output was written despite an error"
 echo "import: $passed passed, 0 failed"

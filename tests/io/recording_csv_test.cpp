@@ -416,6 +416,20 @@ TEST_F(RecordingCsvTest, ErrorOnEmptyColumnName) {
                     {"trailing.csv:1:", "empty column name", "column 3"});
 }
 
+// Found by fuzzing (tests/fuzz/corpus/recording_csv/regression-*): the reader took names and
+// comments that the writer refuses, so an accepted file could not be written back.
+TEST_F(RecordingCsvTest, ErrorOnBlankColumnNameOrCarriageReturnInsideALine) {
+  expect_read_error(write_text("blank_name.csv", "t, ,E\n0,1,2\n"),
+                    {"blank_name.csv:1:", "blank column name ' ' (column 2"});
+  expect_read_error(write_text("cr_name.csv", "# c\nt,E\rx\n0,1\n"),
+                    {"cr_name.csv:2:", "carriage return inside column name"});
+  expect_read_error(write_text("cr_comment.csv", "# a\rb\nt,E\n0,1\n"),
+                    {"cr_comment.csv:1:", "carriage return inside a comment"});
+  // A CRLF line end is still only a line end.
+  EXPECT_EQ(read_recording_csv(write_text("crlf.csv", "# a\r\nt,E\r\n0,1\r\n")).comments,
+            (std::vector<std::string>{"a"}));
+}
+
 TEST_F(RecordingCsvTest, ErrorOnMissingRequiredColumn) {
   expect_read_error(write_text("no_e.csv", "# a\n# b\nt,D\n0,1\n"),
                     {"no_e.csv:3:", "column 'E'", "missing required", "t, D"});

@@ -92,7 +92,23 @@ TEST(YamlMap, LocateAddsTheLineOfAKeyReadEarlier) {
   YamlMap y = plant.map("y");
   static_cast<void>(y.required<int>("z"));
   EXPECT_EQ(root.locate("plant.y.z: 5: too large"), "C.yaml:4: plant.y.z: 5: too large");
-  EXPECT_EQ(root.locate("other: bad"), "C.yaml: other: bad");
+  EXPECT_EQ(root.locate("other: bad"), "C.yaml:1: other: bad");
+}
+
+// Found by fuzzing (tests/fuzz/corpus/daemon_config/regression-default-*): a problem with a key
+// left at its default named no line, against check-config's `FILE:LINE: KEY.PATH: what`.
+TEST(YamlMap, LocateGivesADefaultKeyTheLineOfTheKeyItConflictsWith) {
+  YamlMap root = YamlMap::from_string("a: 1\ncontrol:\n  range: [1, 2]\n", "C.yaml");
+  YamlMap control = root.map("control");
+  std::vector<double> range;
+  control.read_sequence("range", range);
+  EXPECT_EQ(root.locate("safety.value: must be inside control.range"),
+            "C.yaml:3: safety.value: must be inside control.range");
+  // The section, when the key itself is not in the file either; else the document.
+  EXPECT_EQ(root.locate("safety.value: must be inside control.ranges"),
+            "C.yaml:2: safety.value: must be inside control.ranges");
+  EXPECT_EQ(root.locate("safety.value: must be positive"),
+            "C.yaml:1: safety.value: must be positive");
 }
 
 TEST(YamlMap, ParseErrorsAndNonMappingDocuments) {
@@ -104,6 +120,33 @@ TEST(YamlMap, ParseErrorsAndNonMappingDocuments) {
             "C.yaml:1: the document must be a mapping of keys to values");
   EXPECT_EQ(error_of([] { static_cast<void>(YamlMap::load_file("/nonexistent/x.yaml")); }),
             "/nonexistent/x.yaml: cannot open the file");
+}
+
+// Found by fuzzing (tests/fuzz/corpus/daemon_config/regression-*): a YAML escape, a quoted
+// value or a key with a line break made a problem of two lines out of one.
+TEST(YamlMap, EveryErrorIsOneLine) {
+  // yaml-cpp names an unknown escape by its raw byte.
+  EXPECT_EQ(error_of([] { static_cast<void>(YamlMap::from_string("a: \"x\\\x1d\"\n", "C.yaml")); }),
+            "C.yaml:1: unknown escape character: \\x1d");
+  EXPECT_EQ(error_of([] {
+              YamlMap root = YamlMap::from_string("n: \"1\\n2\\t\\e\"\n", "C.yaml");
+              static_cast<void>(root.required<int>("n"));
+            }),
+            "C.yaml:1: n: expected an integer, got '1\\n2\\t\\x1b'");
+  EXPECT_EQ(error_of([] {
+              YamlMap root = YamlMap::from_string("\"bad\\nkey\": 1\n", "C.yaml");
+              root.finish();
+            }),
+            "C.yaml:1: bad\\nkey: unknown key");
+  YamlMap root = YamlMap::from_string("a: 1\n", "C.yaml");
+  EXPECT_EQ(root.locate("driver.type: 'x\ny' is not a type"),
+            "C.yaml:1: driver.type: 'x\\ny' is not a type");
+  const std::string long_value(100, 'v');
+  EXPECT_EQ(error_of([&] {
+              YamlMap map = YamlMap::from_string("n: " + long_value + "\n", "C.yaml");
+              static_cast<void>(map.required<int>("n"));
+            }),
+            "C.yaml:1: n: expected an integer, got '" + long_value.substr(0, 64) + "...'");
 }
 
 }  // namespace

@@ -57,9 +57,10 @@ struct ReadOptions {
   std::vector<std::string> required{"t", "E"};
 };
 
-// Strict reader: a missing required column, a non-numeric or non-finite cell, a row with the
-// wrong number of cells, a t that does not strictly increase or an empty file throws
-// RecordingError naming file, line and column.
+// Strict reader: a missing required column, a blank or duplicated column name, a non-numeric or
+// non-finite cell, a row with the wrong number of cells, a t that does not strictly increase, a
+// carriage return inside a line (not before its '\n') or an empty file throws RecordingError
+// naming file, line and column. What it accepts, write_recording_csv() writes back.
 [[nodiscard]] Recording read_recording_csv(const std::filesystem::path& path,
                                            const ReadOptions& options = {});
 

@@ -1,6 +1,8 @@
 // Strict reading of YAML configuration files: a view over one mapping node that knows its key
 // path ("plant.creep.tau_s[2]"), hands out typed values, and at finish() rejects every key that
-// nobody asked for. Every error is a YamlError whose message starts with "file:line: key.path: ".
+// nobody asked for. Every error is a YamlError whose message starts with "file:line: key.path: "
+// and is one line: line breaks and other control bytes of keys, values and the YAML parser's
+// messages are escapes ("\n", "\x1b"); echoed values are cut to 64 characters.
 //
 // Typical use with plain config structs that carry their defaults in-class:
 //   YamlMap root = YamlMap::load_file("P.yaml");
@@ -96,6 +98,8 @@ class YamlMap final {
 
   // Prefixes "file:line: " to a message that starts with a key path read through any map of this
   // document ("plant.mechanics.resonance_hz: ..."), for validation errors found after loading.
+  // A key path in no line of the file (a default) takes the line of another key path the message
+  // names, else line 1. The result is one line, like every error.
   [[nodiscard]] std::string locate(const std::string& message) const;
   [[nodiscard]] const std::string& source() const noexcept { return context_->source; }
 

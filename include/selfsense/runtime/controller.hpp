@@ -82,7 +82,6 @@ class Controller final {
   double finish(double u) noexcept;  // chain, limits, PID tracking, inverse memory
 
   ControllerConfig config_;
-  double ts_{0.0};
   ControlMode mode_{ControlMode::kPosition};
   control::Pid position_;
   control::Pid force_;
