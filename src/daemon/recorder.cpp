@@ -229,9 +229,10 @@ void Recorder::run() noexcept {
       add_to(w.files, 1);
     }
     if (r.error != 0) {
-      add_to(w.write_errors, 1);
+      // The message first: whoever sees the count (the status, a test) then finds its text.
       set_error(std::string(r.operation) + " " + w.file.path().string() + ": " +
                 std::generic_category().message(r.error));
+      add_to(w.write_errors, 1);
     }
   };
   const auto file_path = [&](unsigned index) {
