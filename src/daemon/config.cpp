@@ -308,6 +308,7 @@ ConfigResult load_config(const std::filesystem::path& path, DriverSectionReader*
     c.model = base / root.required<std::string>("model");
     YamlMap driver = root.map("driver");
     c.driver_type = driver.required<std::string>("type");
+    c.driver_section = driver.canonical_text();
     if (auto m = root.optional_map("control")) read_control(*m, c);
     if (auto m = root.optional_map("safety")) read_safety(*m, c.safety);
     if (auto m = root.optional_map("recorder")) read_recorder(*m, c.recorder, base);

@@ -1,7 +1,10 @@
 #include "selfsense/daemon/control_handler.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <variant>
@@ -17,6 +20,14 @@ constexpr std::chrono::milliseconds kAnswerTimeout{500};
 
 nlohmann::json number_or_null(double x) {
   return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr);
+}
+
+// 64-bit hash as 16 hexadecimal digits (a JSON number would lose bits).
+std::string hex(std::uint64_t value) {
+  std::array<char, 17> text{};
+  static_cast<void>(
+      std::snprintf(text.data(), text.size(), "%016llx", static_cast<unsigned long long>(value)));
+  return {text.data()};
 }
 
 }  // namespace
@@ -96,6 +107,7 @@ nlohmann::json ControlHandler::status() {
   }
   counters["estimate_status"] = estimate_status;
   const auto path = daemon_->recorder().current_path();
+  const RunningParameters running = daemon_->parameters();
   nlohmann::json rt_problems = nlohmann::json::array();
   for (const std::string& p : daemon_->rt_setup().problems)
     rt_problems.push_back(p);
@@ -131,6 +143,11 @@ nlohmann::json ControlHandler::status() {
         {"S", number_or_null(s.last.s_ref)},
         {"T", number_or_null(s.last.t_ref)}}},
       {"wave_running", s.wave_running},
+      {"model", {{"path", running.model.string()}, {"hash", hex(running.model_hash)}}},
+      {"gains",
+       {{"position",
+         {{"kp", running.position.kp}, {"ki", running.position.ki}, {"kd", running.position.kd}}},
+        {"force", {{"kp", running.force.kp}, {"ki", running.force.ki}, {"kd", running.force.kd}}}}},
   });
 }
 
@@ -177,10 +194,12 @@ nlohmann::json ControlHandler::handle(const Request& request, const PeerCredenti
     }
   }
   if (std::holds_alternative<ReloadRequest>(request)) {
-    const std::vector<std::string> problems = daemon_->reload();
-    if (problems.empty()) return ok_reply({{"reloaded", "gains"}});
+    const ReloadResult reloaded = daemon_->reload();
+    if (reloaded.ok()) {
+      return ok_reply({{"reloaded", reloaded.model ? "gains, model" : "gains"}});
+    }
     std::string text;
-    for (const std::string& p : problems)
+    for (const std::string& p : reloaded.problems)
       text += (text.empty() ? "" : "; ") + p;
     return error_reply("reload: " + text);
   }

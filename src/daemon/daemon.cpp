@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <ctime>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -14,6 +15,7 @@
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/daemon/prometheus.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
+#include "selfsense/models/model_identity.hpp"
 #include "selfsense/models/runtime_model.hpp"
 #include "selfsense/runtime/controller.hpp"
 #include "selfsense/runtime/supervisor.hpp"
@@ -57,6 +59,8 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
     : config_(std::move(config)), driver_reader_(&driver_reader), driver_(std::move(driver)) {
   const double ts = config_.sample_time();
   const models::TransducerModel model = models::load_model(config_.model);
+  model_text_ = models::model_to_string(model);
+  model_hash_ = models::parameter_hash(model);
   auto reconstruction = std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts});
   const runtime::Controller controller(config_.control, model.actuator, ts);
   std::string why;
@@ -119,46 +123,146 @@ void Daemon::free_retired() {
   if (!loop_) return;
   runtime::Retired r;
   while (loop_->take_retired(r)) {
-    delete r.wave;   // NOLINT(cppcoreguidelines-owning-memory): handed back by the loop
-    delete r.model;  // NOLINT(cppcoreguidelines-owning-memory)
+    delete r.wave;         // NOLINT(cppcoreguidelines-owning-memory): handed back by the loop
+    delete r.model;        // NOLINT(cppcoreguidelines-owning-memory)
+    delete r.feedforward;  // NOLINT(cppcoreguidelines-owning-memory)
   }
 }
 
-std::vector<std::string> Daemon::reload() {
+namespace {
+
+// A file copied over the old one while it is read ends mid-line far more often than not, and a
+// cut inside a number can leave valid YAML with another value: a reload takes only a file that
+// ends with a line break (every editor writes one; the model file has its own end marker).
+bool ends_with_line_break(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in || in.tellg() <= 0) return false;
+  in.seekg(-1, std::ios::end);
+  char last = 0;
+  return static_cast<bool>(in.get(last)) && last == '\n';
+}
+
+}  // namespace
+
+ReloadResult Daemon::reload() {
+  ReloadResult result;
+  if (!ends_with_line_break(config_.source)) {
+    result.problems.push_back(config_.source.string() +
+                              ": does not end with a line break: taken as still being written "
+                              "(save it whole, then reload)");
+    return result;
+  }
   ConfigResult next = load_config(config_.source, driver_reader_);
-  std::vector<std::string> problems = next.problems;
-  if (!problems.empty()) return problems;
+  if (!next.ok()) {
+    result.problems = std::move(next.problems);
+    return result;
+  }
   const DaemonConfig& n = next.config;
+  std::vector<std::string>& problems = result.problems;
   const auto refuse = [&](bool changed, const char* key) {
     if (changed) {
       problems.push_back(config_.source.string() + ": " + key +
                          ": cannot change while running (restart the service)");
     }
   };
-  refuse(n.loop.rate_hz != config_.loop.rate_hz, "loop.rate_hz");
-  refuse(n.loop.priority != config_.loop.priority, "loop.priority");
-  refuse(n.loop.cpu != config_.loop.cpu, "loop.cpu");
-  refuse(n.model != config_.model, "model");
-  refuse(n.driver_type != config_.driver_type, "driver.type");
-  refuse(n.control.mode != config_.control.mode, "control.mode");
-  refuse(n.control.command_min != config_.control.command_min ||
-             n.control.command_max != config_.control.command_max,
+  const DaemonConfig& o = config_;
+  refuse(n.loop.rate_hz != o.loop.rate_hz, "loop.rate_hz");
+  refuse(n.loop.priority != o.loop.priority, "loop.priority");
+  refuse(n.loop.cpu != o.loop.cpu, "loop.cpu");
+  refuse(n.loop.allow_degraded_timing != o.loop.allow_degraded_timing,
+         "loop.allow_degraded_timing");
+  refuse(n.loop.status_period_cycles != o.loop.status_period_cycles, "loop.status_period_cycles");
+  refuse(n.driver_type != o.driver_type, "driver.type");
+  refuse(n.driver_type == o.driver_type && n.driver_section != o.driver_section, "driver");
+  const runtime::ControllerConfig& nc = n.control;
+  const runtime::ControllerConfig& oc = o.control;
+  const auto without_gains = [](control::Pid::Params p) {
+    p.gains = {};
+    return p;
+  };
+  refuse(nc.mode != oc.mode, "control.mode");
+  refuse(nc.feedforward != oc.feedforward, "control.feedforward");
+  refuse(nc.command_min != oc.command_min || nc.command_max != oc.command_max,
          "control.command_v_per_m");
-  refuse(n.recorder.directory != config_.recorder.directory, "recorder.directory");
-  refuse(n.socket.path != config_.socket.path, "socket.path");
-  if (!problems.empty()) return problems;
+  refuse(nc.force_direction != oc.force_direction, "control.force_direction");
+  refuse(without_gains(nc.position) != without_gains(oc.position),
+         "control.position (only kp, ki, kd reload)");
+  refuse(without_gains(nc.force) != without_gains(oc.force),
+         "control.force (only kp, ki, kd reload)");
+  refuse(nc.position_shaper != oc.position_shaper, "control.position_shaper");
+  refuse(nc.force_shaper != oc.force_shaper, "control.force_shaper");
+  refuse(nc.damping != oc.damping, "control.damping");
+  refuse(n.filters != o.filters, "control.filters");
+  refuse(n.safety != o.safety, "safety");
+  refuse(n.recorder != o.recorder, "recorder");
+  refuse(n.socket != o.socket, "socket");
+  refuse(n.telemetry != o.telemetry, "telemetry");
+
+  // The model, read once more: load_config checked it, but the file may have changed since.
+  std::unique_ptr<models::Reconstruction> reconstruction;
+  std::unique_ptr<runtime::Feedforward> feedforward;
+  std::string model_text;
+  std::uint64_t model_hash = 0;
+  try {
+    const models::TransducerModel model = models::load_model(n.model);
+    model_text = models::model_to_string(model);
+    model_hash = models::parameter_hash(model);
+    if (model_text != model_text_) {
+      const double ts = config_.sample_time();
+      reconstruction = std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts});
+      feedforward = std::make_unique<runtime::Feedforward>(
+          runtime::make_feedforward(config_.control, model.actuator, ts));
+    }
+  } catch (const std::exception& e) {
+    problems.push_back(std::string("model: ") + e.what());
+  }
+  if (!problems.empty()) return result;
+
+  if (reconstruction) {
+    runtime::LoopCommand c;
+    c.kind = runtime::CommandKind::kSwapModel;
+    c.model = reconstruction.get();
+    c.feedforward = feedforward.get();
+    bool submitted = false;
+    const auto answer = command(c, std::chrono::milliseconds(500), &submitted);
+    if (submitted) {  // the loop owns them now (it hands back what it refuses)
+      static_cast<void>(reconstruction.release());
+      static_cast<void>(feedforward.release());
+    }
+    if (!answer || answer->result != runtime::CommandResult::kDone) {
+      problems.push_back(
+          "model: " + n.model.string() +
+          (answer && answer->result == runtime::CommandResult::kRefusedState
+               ? ": a new model is taken only while disarmed (the loop is armed); disarm and "
+                 "reload"
+               : ": the loop did not take the new model"));
+      return result;
+    }
+    const std::lock_guard lock(parameters_mutex_);
+    config_.model = n.model;
+    model_text_ = std::move(model_text);
+    model_hash_ = model_hash;
+    result.model = true;
+  }
   runtime::LoopCommand c;
   c.kind = runtime::CommandKind::kGains;
-  c.position = n.control.position.gains;
-  c.force = n.control.force.gains;
+  c.position = nc.position.gains;
+  c.force = nc.force.gains;
   const auto answer = command(c, std::chrono::milliseconds(500));
   if (!answer || answer->result != runtime::CommandResult::kDone) {
     problems.push_back(config_.source.string() + ": control: the loop refused the new gains");
-    return problems;
+    return result;
   }
-  config_.control.position.gains = n.control.position.gains;
-  config_.control.force.gains = n.control.force.gains;
-  return problems;
+  const std::lock_guard lock(parameters_mutex_);
+  config_.control.position.gains = nc.position.gains;
+  config_.control.force.gains = nc.force.gains;
+  result.gains = true;
+  return result;
+}
+
+RunningParameters Daemon::parameters() const {
+  const std::lock_guard lock(parameters_mutex_);
+  return {config_.model, model_hash_, config_.control.position.gains, config_.control.force.gains};
 }
 
 void Daemon::notify_status() {
@@ -239,11 +343,13 @@ int Daemon::run() {
     if (sig == SIGTERM || sig == SIGINT) break;
     if (sig == SIGHUP) {
       static_cast<void>(sd_notify(0, "RELOADING=1"));
-      const std::vector<std::string> problems = reload();
-      for (const std::string& p : problems)
+      const ReloadResult reloaded = reload();
+      for (const std::string& p : reloaded.problems)
         static_cast<void>(std::fprintf(stderr, "selfsensed: reload refused: %s\n", p.c_str()));
-      if (problems.empty())
-        static_cast<void>(std::fprintf(stderr, "selfsensed: reloaded the gains\n"));
+      if (reloaded.ok()) {
+        static_cast<void>(std::fprintf(stderr, "selfsensed: reloaded the gains%s\n",
+                                       reloaded.model ? " and the model" : ""));
+      }
       static_cast<void>(sd_notify(0, "READY=1"));
     }
     const std::uint64_t progress = runner_->progress();

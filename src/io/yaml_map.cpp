@@ -204,6 +204,17 @@ std::vector<YamlMap> YamlMap::maps(std::string_view key) {
   return out;
 }
 
+std::string YamlMap::last_key() const {
+  std::string last;
+  for (const auto& pair : node_)
+    last = pair.first.Scalar();
+  return last;
+}
+
+std::string YamlMap::canonical_text() const {
+  return YAML::Dump(node_);
+}
+
 void YamlMap::finish() const {
   std::set<std::string, std::less<>> seen;
   for (const auto& pair : node_) {

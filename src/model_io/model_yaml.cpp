@@ -1,9 +1,12 @@
 #include "selfsense/model_io/model_yaml.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <array>
-#include <fstream>
+#include <cerrno>
+#include <cstring>
 #include <optional>
 #include <stdexcept>
 #include <string_view>
@@ -171,10 +174,25 @@ std::optional<ChannelCorrection> read_correction(YamlMap& corrections, std::stri
 
 TransducerModel read_model(YamlMap root) {
   const int version = root.required<int>("selfsense_model");
-  if (version != kModelFormatVersion) {
+  if (version < kOldestModelFormatVersion || version > kModelFormatVersion) {
     root.fail("selfsense_model", "format version " + std::to_string(version) +
                                      " is not supported (this build reads " +
+                                     std::to_string(kOldestModelFormatVersion) + " to " +
                                      std::to_string(kModelFormatVersion) + ")");
+  }
+  // From version 2 the last key says the file is whole: a file cut short (copied over the old
+  // one while the daemon reloads, a copy interrupted) lacks it, even where the cut leaves valid
+  // YAML (a number cut to fewer digits, a sequence that lost its tail lines).
+  if (version >= 2 || root.has("complete")) {
+    if (!root.has("complete")) {
+      root.fail("complete",
+                "missing: a model file of format 2 ends with `complete: true`; this "
+                "one ends before it (cut short, half-written?)");
+    }
+    if (!root.required<bool>("complete")) root.fail("complete", "must be true");
+    if (root.last_key() != "complete") {
+      root.fail("complete", "must be the file's last key (a model file ends with it)");
+    }
   }
   TransducerModel model;
   const auto name = root.required<std::string>("structure");
@@ -348,17 +366,46 @@ std::string model_to_string(const TransducerModel& model, const std::string& fit
     out << YAML::EndMap;
   }
   if (!fit_notes.empty()) out << YAML::Key << "fit" << YAML::Value << YAML::Load(fit_notes);
+  out << YAML::Key << "complete" << YAML::Value << true;  // last: the file is whole
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
 
+// Written beside the target and renamed over it: a reader (the daemon reloading) sees the old
+// file or the new one, never a part of it; fsync first, so a power cut cannot leave the new
+// name on an empty file.
 void save_model(const TransducerModel& model, const std::filesystem::path& path,
                 const std::string& fit_notes) {
   const std::string text = model_to_string(model, fit_notes);
-  std::ofstream file(path);
-  if (!file || !(file << text) || !file.flush()) {
-    throw std::runtime_error(path.string() + ": cannot write the model");
+  const std::filesystem::path parent = path.has_parent_path() ? path.parent_path() : ".";
+  std::string temp_name = path.filename().string();  // appended, not "." + ...: gcc 12 -Wrestrict
+  temp_name.insert(0, 1, '.');
+  temp_name.append(".tmp-").append(std::to_string(::getpid()));
+  const std::filesystem::path temp = parent / temp_name;
+  const auto fail = [&](const char* what) {
+    const int error = errno;
+    static_cast<void>(::unlink(temp.c_str()));
+    throw std::runtime_error(path.string() + ": cannot write the model (" + what + ": " +
+                             std::strerror(error) + ")");
+  };
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail("open");
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      static_cast<void>(::close(fd));
+      fail("write");
+    }
+    done += static_cast<std::size_t>(n);
   }
+  if (::fsync(fd) != 0) {
+    static_cast<void>(::close(fd));
+    fail("fsync");
+  }
+  if (::close(fd) != 0) fail("close");
+  if (::rename(temp.c_str(), path.c_str()) != 0) fail("rename");
 }
 
 }  // namespace selfsense::models

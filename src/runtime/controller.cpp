@@ -4,6 +4,7 @@
 #include <cmath>
 #include <span>
 #include <stdexcept>
+#include <utility>
 
 namespace selfsense::runtime {
 namespace {
@@ -16,6 +17,17 @@ control::Pid::Params limited(control::Pid::Params p, const ControllerConfig& c) 
 
 }  // namespace
 
+Feedforward make_feedforward(const ControllerConfig& config,
+                             const std::optional<models::SideModel>& actuator, double sample_time) {
+  Feedforward ff;
+  if (!config.feedforward || !actuator) return ff;
+  ff.inverse.emplace(actuator->op, sample_time);
+  ff.inverse->set_history(actuator->history);
+  ff.compliance = actuator->linear_gains.empty() ? 0.0 : actuator->linear_gains.front();
+  ff.strain_offset = actuator->offset;
+  return ff;
+}
+
 Controller::Controller(const ControllerConfig& config,
                        const std::optional<models::SideModel>& actuator, double sample_time)
     : config_(config),
@@ -24,7 +36,8 @@ Controller::Controller(const ControllerConfig& config,
       force_(limited(config.force, config), sample_time),
       position_shaper_(config.position_shaper, sample_time),
       force_shaper_(config.force_shaper, sample_time),
-      chain_(std::span(config.filters).first(config.filter_count)) {
+      chain_(std::span(config.filters).first(config.filter_count)),
+      ff_(make_feedforward(config, actuator, sample_time)) {
   if (!(config.command_min < config.command_max)) {
     throw std::invalid_argument("control.command: min must be < max");
   }
@@ -32,18 +45,17 @@ Controller::Controller(const ControllerConfig& config,
     throw std::invalid_argument("control.force_direction: must be 1 or -1");
   }
   if (config.damping.gain > 0.0) damping_.emplace(config.damping, sample_time);
-  if (config.feedforward && actuator) {
-    inverse_.emplace(actuator->op, sample_time);
-    inverse_->set_history(actuator->history);
-    compliance_ = actuator->linear_gains.empty() ? 0.0 : actuator->linear_gains.front();
-    strain_offset_ = actuator->offset;
-  }
+}
+
+void Controller::swap_feedforward(Feedforward& next) noexcept {
+  std::swap(ff_, next);
+  if (ff_.inverse) ff_.inverse->reset(last_command_);
 }
 
 double Controller::feedforward(double strain) noexcept {
-  if (!inverse_) return 0.0;
-  const double target = strain - compliance_ * ff_stress_ - strain_offset_;
-  const double e = inverse_->input_for(target);
+  if (!ff_.inverse) return 0.0;
+  const double target = strain - ff_.compliance * ff_stress_ - ff_.strain_offset;
+  const double e = ff_.inverse->input_for(target);
   return std::isfinite(e) ? std::clamp(e, config_.command_min, config_.command_max) : 0.0;
 }
 
@@ -56,7 +68,7 @@ double Controller::finish(double u) noexcept {
   const double applied_raw = u + (e - filtered);
   if (mode_ == ControlMode::kPosition) position_.track(applied_raw);
   if (mode_ == ControlMode::kForce) force_.track(applied_raw);
-  if (inverse_) static_cast<void>(inverse_->step(e));
+  if (ff_.inverse) static_cast<void>(ff_.inverse->step(e));
   last_command_ = e;
   return e;
 }

@@ -77,7 +77,15 @@ Loop::Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Rec
   status_.mode = controller_.mode();
 }
 
-Loop::~Loop() = default;
+// Whatever the control thread did not collect is freed here (never on the loop thread).
+Loop::~Loop() {
+  Retired r;
+  while (retired_.try_pop(r)) {
+    delete r.wave;         // NOLINT(cppcoreguidelines-owning-memory): handed back by handle()
+    delete r.model;        // NOLINT(cppcoreguidelines-owning-memory)
+    delete r.feedforward;  // NOLINT(cppcoreguidelines-owning-memory)
+  }
+}
 
 double Loop::safe_command() const noexcept {
   return config_.safe_output == SafeOutput::kHold ? command_ : config_.safe_value;
@@ -120,7 +128,7 @@ void Loop::handle(const LoopCommand& c) noexcept {
       wave_running_ = false;
       return answer(c, CommandResult::kDone);
     case CommandKind::kWave:
-      if (wave_) static_cast<void>(retired_.try_push({wave_.release(), nullptr}));
+      if (wave_) static_cast<void>(retired_.try_push({wave_.release(), nullptr, nullptr}));
       wave_.reset(c.wave);
       wave_running_ = wave_ != nullptr;
       last_feed_ = cycle_;
@@ -133,9 +141,16 @@ void Loop::handle(const LoopCommand& c) noexcept {
       return answer(c, controller_.set_gains(c.position, c.force) ? CommandResult::kDone
                                                                   : CommandResult::kInvalid);
     case CommandKind::kSwapModel:
-      if (c.model == nullptr) return answer(c, CommandResult::kInvalid);
+      // Not under a closed loop: the new model's estimate may differ from the old one's, and
+      // a step of the estimate would be a step of the actuator. What is refused is handed back.
+      if (c.model == nullptr || supervisor_.state() == LoopState::kArmed) {
+        static_cast<void>(retired_.try_push({nullptr, c.model, c.feedforward}));
+        return answer(c,
+                      c.model == nullptr ? CommandResult::kInvalid : CommandResult::kRefusedState);
+      }
       c.model->adopt_state(*model_);
-      static_cast<void>(retired_.try_push({nullptr, model_.release()}));
+      if (c.feedforward != nullptr) controller_.swap_feedforward(*c.feedforward);
+      static_cast<void>(retired_.try_push({nullptr, model_.release(), c.feedforward}));
       model_.reset(c.model);
       ++status_.model_swaps;
       return answer(c, CommandResult::kDone);

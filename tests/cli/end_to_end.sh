@@ -25,7 +25,8 @@ YAML
 "$bin" identify --recording "$work/r.csv" --structure hysteresis-creep --out "$work/m.yaml" \
   --json "$work/m.json" --plays 12 --eigenvalues 3 >"$work/identify.txt"
 grep -q '"held_out"' "$work/m.json" || fail "identify JSON has no held_out figures"
-grep -q '^selfsense_model: 1' "$work/m.yaml" || fail "model file has no version"
+grep -q '^selfsense_model: 2' "$work/m.yaml" || fail "model file has no version"
+tail -n 1 "$work/m.yaml" | grep -qx 'complete: true' || fail "model file does not end with its end marker"
 # The fitted model explains S well on the held-out part (nrmse below 2 %).
 held_s=$(sed -n 's/^  S  *[0-9.]* % *[0-9.]* % *\([0-9.]*\) %.*/\1/p' "$work/identify.txt")
 awk -v v="$held_s" 'BEGIN { exit !(v != "" && v < 2.0) }' || fail "held-out S nrmse '$held_s' %"

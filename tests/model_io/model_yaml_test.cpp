@@ -1,7 +1,10 @@
 #include "selfsense/model_io/model_yaml.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "selfsense/identification/stress_hysteresis_fit.hpp"
@@ -114,6 +117,64 @@ sensor:
   coupling: 1.0
 )",
                "sensor.hysteresis: required key is missing");
+}
+
+// A file cut short anywhere (copied over the old one while the daemon reloads, a copy that was
+// interrupted) is refused: without the end marker a cut inside a number or after a line of a
+// list leaves valid YAML and a different model.
+TEST(ModelYaml, EveryPrefixOfASavedModelIsRefused) {
+  TransducerModel m = test::typical_transducer(1e-4);
+  const std::string text = model_to_string(m, "S: {nrmse: 0.001}");
+  ASSERT_EQ(text.substr(text.size() - 15), "complete: true\n");
+  std::size_t accepted = 0;
+  for (std::size_t n = 0; n + 1 < text.size(); ++n) {  // the last byte is the final newline
+    try {
+      static_cast<void>(model_from_string(text.substr(0, n), "M.yaml"));
+      ++accepted;
+      ADD_FAILURE() << "a prefix of " << n << " of " << text.size() << " bytes loaded";
+    } catch (const io::YamlError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("M.yaml", 0), 0U) << e.what();
+    }
+  }
+  EXPECT_EQ(accepted, 0U);
+  EXPECT_NO_THROW(static_cast<void>(model_from_string(text.substr(0, text.size() - 1))));
+}
+
+TEST(ModelYaml, TheEndMarkerIsRequiredFromFormatTwoAndMustBeLast) {
+  const std::string v2 = "selfsense_model: 2" + kMinimal.substr(kMinimal.find('\n'));
+  expect_error(v2, "complete: missing");
+  EXPECT_NO_THROW(static_cast<void>(model_from_string(v2 + "complete: true\n")));
+  expect_error(v2 + "complete: false\n", "complete: must be true");
+  std::string early = v2;
+  early.insert(early.find("sample_time_s"), "complete: true\n");
+  expect_error(early, "complete: must be the file's last key");
+  EXPECT_NO_THROW(static_cast<void>(model_from_string(kMinimal)));  // format 1: no marker
+  expect_error("selfsense_model: 3" + kMinimal.substr(kMinimal.find('\n')),
+               "format version 3 is not supported (this build reads 1 to 2)");
+}
+
+// save_model replaces the file in one rename: the old content or the new, nothing between,
+// and no temporary file left behind.
+TEST(ModelYaml, SaveReplacesTheFileWhole) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("selfsense-model-save-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path path = dir / "m.yaml";
+  {
+    std::ofstream old(path);
+    old << "an old file, longer than nothing\n";
+  }
+  const TransducerModel m = test::typical_transducer(1e-4);
+  save_model(m, path, "S: {nrmse: 0.001}");
+  EXPECT_EQ(model_to_string(load_model(path)), model_to_string(m));
+  std::size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    static_cast<void>(entry);
+    ++files;
+  }
+  EXPECT_EQ(files, 1U);
+  EXPECT_THROW(save_model(m, dir / "missing" / "m.yaml"), std::runtime_error);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -56,6 +56,7 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
             Controller(cc, model.actuator, kTs), &sink);
   // Prepared outside the loop, as the control thread does.
   auto next_model = std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{kTs});
+  auto next_feedforward = std::make_unique<Feedforward>(make_feedforward(cc, model.actuator, kTs));
   control::WaveGenerator::Config wc;
   wc.shape = control::WaveGenerator::Shape::kSine;
   wc.amplitude = 2e-4;
@@ -77,7 +78,11 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
       if (phase == 20) c.kind = CommandKind::kArm;
       if (phase == 100) c = {id, CommandKind::kSetpoint, mode == ControlMode::kForce ? -6e6 : 5e-4};
       if (k == 5000) c = {id, CommandKind::kWave, 0.0, mode, wave.release()};
-      if (k == 30000) c = {id, CommandKind::kSwapModel, 0.0, mode, nullptr, next_model.release()};
+      if (k == 25003) c.kind = CommandKind::kDisarm;  // a swap is refused while armed
+      if (k == 25005) {
+        c = {id, CommandKind::kSwapModel, 0.0, mode, nullptr, next_model.release()};
+        c.feedforward = next_feedforward.release();
+      }
       if (k == 60000) {
         ASSERT_TRUE(driver.inject(plant::FaultKind::nan_sample, plant::Channel::d, 1, 3));
       }
@@ -96,6 +101,7 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
   while (loop.take_retired(r)) {
     delete r.wave;
     delete r.model;
+    delete r.feedforward;
   }
   EXPECT_EQ(sink.count_, 100000U);
   EXPECT_GT(loop.local_status().commands, 10U);

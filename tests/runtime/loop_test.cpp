@@ -268,6 +268,46 @@ TEST(Loop, ArmingIsRefusedWhileFaultedAndResetIsRefusedWhileTheCauseLasts) {
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kFaulted);
 }
 
+// A model reload: refused while armed (the new estimate would step the actuator) and the
+// objects handed back; taken while disarmed, the feedforward with it, and the loop tracks again.
+TEST(Loop, AModelIsSwappedOnlyWhileDisarmedWithItsFeedforward) {
+  ControllerConfig control = bench_control();
+  Bench b(test::daemon_plant(kRate), control);
+  start(b, ControlMode::kPosition);
+  const auto offer = [&] {
+    LoopCommand c{0, CommandKind::kSwapModel};
+    c.model = new models::Reconstruction(bench_model(), models::RuntimeOptions{kTs});
+    c.feedforward = new Feedforward(make_feedforward(control, bench_model().actuator, kTs));
+    return b.send(c);
+  };
+  const auto collect = [&] {
+    std::size_t n = 0;
+    Retired r;
+    while (b.loop->take_retired(r)) {
+      n += (r.model != nullptr ? 1U : 0U) + (r.feedforward != nullptr ? 1U : 0U);
+      delete r.model;
+      delete r.feedforward;
+    }
+    return n;
+  };
+  EXPECT_EQ(offer(), CommandResult::kRefusedState);
+  EXPECT_EQ(collect(), 2U);  // the offered model and feedforward, untouched
+  EXPECT_EQ(b.loop->local_status().model_swaps, 0U);
+
+  ASSERT_EQ(b.send({0, CommandKind::kDisarm}), CommandResult::kDone);
+  EXPECT_EQ(offer(), CommandResult::kDone);
+  EXPECT_EQ(collect(), 2U);  // the replaced model and feedforward
+  EXPECT_EQ(b.loop->local_status().model_swaps, 1U);
+  EXPECT_TRUE(b.loop->controller().has_feedforward());
+
+  ASSERT_EQ(b.send({0, CommandKind::kArm}), CommandResult::kDone);
+  b.send({0, CommandKind::kSetpoint, 8e-4});
+  b.run(0.3);
+  const LoopSample& s = b.loop->local_status().last;
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+  EXPECT_NEAR(s.s_hat, 8e-4, 2e-5);  // 2 % of the setpoint: tracking on the new model
+}
+
 TEST(Loop, OverrunPolicyAndWatchdogFault) {
   LoopConfig lc;
   lc.overrun = {3, 5, 100};

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Host side of payload/daemon_systemd.sh: selfsensed under systemd as PID 1 (Type=notify,
-# watchdog restart of a frozen daemon, clean stop).
+# watchdog restart of a frozen daemon, restart faulted after kill -9, clean stop).
 #   tests/vm/daemon_systemd.sh OUT_DIR   (after tests/vm/boot.sh OUT_DIR ...)
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=lib.sh
@@ -16,6 +16,9 @@ vm_check_test "${1:?usage: tests/vm/daemon_systemd.sh OUT_DIR}" daemon_systemd \
   'nrestarts_after_freeze=[1-9][0-9]*' \
   'watchdog_timeout_logged=yes' \
   'is-active_after_restart=active' \
+  'state_before_kill9=armed' \
+  'restarted_after_kill9=yes' \
+  'state_after_kill9=faulted' \
   'is-active_after_stop=inactive' \
   'exit_status=0' \
   'clean_stop_logged=yes'

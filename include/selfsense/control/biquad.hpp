@@ -38,6 +38,7 @@ struct BiquadCoefficients {
   [[nodiscard]] double dc_gain() const noexcept;
   // H(e^{j 2 pi f Ts}) at frequency f [Hz].
   [[nodiscard]] std::complex<double> response(double frequency, double sample_time) const noexcept;
+  friend bool operator==(const BiquadCoefficients&, const BiquadCoefficients&) = default;
 };
 
 class Biquad final {

@@ -60,6 +60,7 @@ class DampingController final {
     double dc_block_frequency{0.0};  // f_b [Hz] >= 0; 0 = no high-pass in front
 
     [[nodiscard]] bool is_valid(double sample_time, std::string* why) const;
+    friend bool operator==(const Params&, const Params&) = default;
   };
 
   static constexpr std::size_t kStateSize = 2 * Biquad::kStateSize;

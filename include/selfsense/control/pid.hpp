@@ -46,6 +46,7 @@ class Pid final {
     double kp{0.0};  // [u/x] >= 0
     double ki{0.0};  // [u/(x s)] >= 0
     double kd{0.0};  // [u s/x] >= 0
+    friend bool operator==(const Gains&, const Gains&) = default;
   };
 
   struct Params {
@@ -59,6 +60,7 @@ class Pid final {
     bool conditional_integration{true};
 
     [[nodiscard]] bool is_valid(double sample_time, std::string* why) const;
+    friend bool operator==(const Params&, const Params&) = default;
   };
 
   static constexpr std::size_t kStateSize = 6;

@@ -37,6 +37,7 @@ class SetpointShaper final {
     double time_constant{0.0};  // tau [s] > 0 when filter != kNone
 
     [[nodiscard]] bool is_valid(double sample_time, std::string* why) const;
+    friend bool operator==(const Params&, const Params&) = default;
   };
 
   static constexpr std::size_t kStateSize = 3;

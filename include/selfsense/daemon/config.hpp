@@ -55,6 +55,7 @@ struct LoopSection {
   int cpu{-1};       // affinity; -1: any
   bool allow_degraded_timing{false};
   std::uint32_t status_period_cycles{100};
+  friend bool operator==(const LoopSection&, const LoopSection&) = default;
 };
 
 struct FilterSection {
@@ -63,11 +64,13 @@ struct FilterSection {
   double quality{0.0};
   double bandwidth_hz{0.0};
   double depth_db{40.0};
+  friend bool operator==(const FilterSection&, const FilterSection&) = default;
 };
 
 struct Range {
   double min{0.0};
   double max{0.0};
+  friend bool operator==(const Range&, const Range&) = default;
 };
 
 struct SafetySection {
@@ -79,6 +82,7 @@ struct SafetySection {
   Range setpoint_stress_pa{-3e7, 1e7};
   runtime::OverrunPolicy overrun{};
   double watchdog_s{0.0};
+  friend bool operator==(const SafetySection&, const SafetySection&) = default;
 };
 
 struct RecorderSection {
@@ -88,17 +92,20 @@ struct RecorderSection {
   std::size_t ring_capacity{1U << 18U};  // about 13 s at 20 kHz
   double flight_recorder_s{5.0};
   bool record_at_start{false};
+  friend bool operator==(const RecorderSection&, const RecorderSection&) = default;
 };
 
 struct SocketSection {
   std::filesystem::path path{"/run/selfsensed/control.sock"};
   std::string group{};  // empty: the daemon's own group
   int max_clients{16};
+  friend bool operator==(const SocketSection&, const SocketSection&) = default;
 };
 
 struct TelemetrySection {
   std::filesystem::path prometheus_file{};  // empty: none
   double period_s{1.0};
+  friend bool operator==(const TelemetrySection&, const TelemetrySection&) = default;
 };
 
 struct DaemonConfig {
@@ -106,6 +113,7 @@ struct DaemonConfig {
   LoopSection loop{};
   std::filesystem::path model{};
   std::string driver_type{};
+  std::string driver_section{};  // the `driver` mapping as text (a reload compares it)
   runtime::ControllerConfig control{};
   std::vector<FilterSection> filters{};
   SafetySection safety{};

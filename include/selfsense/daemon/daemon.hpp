@@ -7,8 +7,7 @@
 //   SIGTERM, SIGINT   disarm (the loop writes the safe output from the next cycle), stop the
 //                     loop, drive the amplifier to its safe output (driver deactivate), flush and
 //                     close the recorder, STOPPING=1, exit 0
-//   SIGHUP            reload the parameters that are safe to change while armed (the gains);
-//                     any other changed key is refused with a message naming it
+//   SIGHUP            reload (reload() below)
 // systemd (Type=notify): READY=1 once the loop runs, STATUS= every second, WATCHDOG=1 only while
 // the loop makes progress (a stalled loop gets the service restarted), STOPPING=1.
 #pragma once
@@ -32,6 +31,22 @@
 #include "selfsense/runtime/pacer.hpp"
 
 namespace selfsense::daemon {
+
+// What a reload did. When problems is not empty nothing changed.
+struct ReloadResult {
+  std::vector<std::string> problems{};  // one line each, naming the file and the key
+  bool gains{false};                    // the PID gains were applied
+  bool model{false};                    // a new model runs
+  [[nodiscard]] bool ok() const noexcept { return problems.empty(); }
+};
+
+// The parameters a reload can change, as they run now.
+struct RunningParameters {
+  std::filesystem::path model{};
+  std::uint64_t model_hash{0};  // models::parameter_hash (models/model_identity.hpp)
+  control::Pid::Gains position{};
+  control::Pid::Gains force{};
+};
 
 class Daemon final {
  public:
@@ -69,8 +84,15 @@ class Daemon final {
   [[nodiscard]] bool may_arm() const noexcept {
     return rt_setup_.complete() || config_.loop.allow_degraded_timing;
   }
-  // The problems of the last reload (empty: applied).
-  std::vector<std::string> reload();
+  // Reads the configuration file and the model file again; all or nothing. Applied while armed:
+  // the PID gains. Applied while disarmed: a model whose content changed (the same file
+  // rewritten, or another path), with the feedforward's inverse built from it; its memory is
+  // carried over (runtime_model.hpp, adopt_state). Any other changed key, a file that does not
+  // load (half-written: a YAML or model error naming file and line) or a model change while
+  // armed is refused by name and the running parameters stay.
+  ReloadResult reload();
+  // What runs now (any thread; a reload changes it).
+  [[nodiscard]] RunningParameters parameters() const;
   // Test hook for the watchdog: the loop stops making progress.
   void stall_loop(bool on) noexcept { runner_->stall(on); }
   void request_stop() noexcept { stop_requested_.store(true); }
@@ -95,6 +117,9 @@ class Daemon final {
   std::mutex command_mutex_{};  // one producer and one answer reader at a time
   std::uint64_t next_id_{0};
   std::atomic<bool> stop_requested_{false};
+  std::string model_text_{};  // the running model as models::model_to_string writes it
+  std::uint64_t model_hash_{0};
+  mutable std::mutex parameters_mutex_{};  // config_.model, model_hash_, the gains: reload writes
 };
 
 }  // namespace selfsense::daemon

@@ -102,6 +102,11 @@ class YamlMap final {
   // names, else line 1. The result is one line, like every error.
   [[nodiscard]] std::string locate(const std::string& message) const;
   [[nodiscard]] const std::string& source() const noexcept { return context_->source; }
+  // The mapping's last key in the document's order (empty for an empty mapping).
+  [[nodiscard]] std::string last_key() const;
+  // The mapping as YAML text, comments and layout dropped: two readings compare equal when
+  // their content is the same.
+  [[nodiscard]] std::string canonical_text() const;
 
  private:
   struct Context {

@@ -1,7 +1,7 @@
 // Transducer models as versioned YAML files (target selfsense::model_io; the math libraries
 // know nothing of files).
 //
-//   selfsense_model: 1
+//   selfsense_model: 2                   # format version (1 is read too)
 //   structure: hysteresis-creep          # linear | permittivity | hysteresis | ...
 //   sample_time_s: 1.0e-4
 //   geometry: {layer_thickness_m, electrode_area_m2, layers, active_length_m, cross_section_m2}
@@ -27,6 +27,7 @@
 //     sensed: {gain, offset, leakage_tau_s, delay_s, ...}   # (models/channel_correction.hpp)
 //     strain: {gain, creep_eigenvalues, creep_weights, dynamics_frequency_hz, ...}
 //   fit: {...}                           # free-form notes written by identify, not read back
+//   complete: true                       # format 2: the last key; a file cut short lacks it
 // Loading is strict: unknown keys, missing fields, wrong types and parameters that make an
 // operator non-invertible are errors naming file, line and key path.
 #pragma once
@@ -38,7 +39,8 @@
 
 namespace selfsense::models {
 
-inline constexpr int kModelFormatVersion = 1;
+inline constexpr int kModelFormatVersion = 2;        // what save_model writes
+inline constexpr int kOldestModelFormatVersion = 1;  // 1: no `complete` key
 
 // Throws io::YamlError ("M.yaml:12: sensor.hysteresis.weights[3]: ...").
 [[nodiscard]] TransducerModel load_model(const std::filesystem::path& path);

@@ -39,6 +39,22 @@
 
 namespace selfsense::runtime {
 
+struct ControllerConfig;
+
+// The feedforward's inverse model: built outside the loop (construction allocates), exchanged
+// into a running controller with Controller::swap_feedforward() (a model reload).
+struct Feedforward {
+  std::optional<operators::HysteresisCreep> inverse{};  // empty: no feedforward
+  double compliance{0.0};                               // sE of the actuator side
+  double strain_offset{0.0};
+};
+
+// The feedforward of `actuator` at `sample_time` [s] (empty when the configuration disables it
+// or the model has no actuator side). Throws what the operator's construction throws.
+[[nodiscard]] Feedforward make_feedforward(const ControllerConfig& config,
+                                           const std::optional<models::SideModel>& actuator,
+                                           double sample_time);
+
 struct ControllerConfig {
   ControlMode mode{ControlMode::kPosition};
   control::Pid::Params position{};  // E [V/m] per unit strain
@@ -73,7 +89,11 @@ class Controller final {
 
   [[nodiscard]] ControlMode mode() const noexcept { return mode_; }
   [[nodiscard]] double shaped_setpoint() const noexcept { return shaped_; }
-  [[nodiscard]] bool has_feedforward() const noexcept { return inverse_.has_value(); }
+  [[nodiscard]] bool has_feedforward() const noexcept { return ff_.inverse.has_value(); }
+  // Exchanges the feedforward with `next` (which then holds the old one, to be freed outside the
+  // loop). The new inverse's memory starts settled at the command now applied: the old one's
+  // plays cannot be carried over to other thresholds. No allocation (moves only).
+  void swap_feedforward(Feedforward& next) noexcept;
   [[nodiscard]] std::size_t saturations() const noexcept { return saturations_; }
 
  private:
@@ -89,9 +109,7 @@ class Controller final {
   control::SetpointShaper force_shaper_;
   control::FilterChain chain_{};
   std::optional<control::DampingController> damping_{};
-  std::optional<operators::HysteresisCreep> inverse_{};  // memory follows the applied E
-  double compliance_{0.0};                               // sE of the actuator side
-  double strain_offset_{0.0};
+  Feedforward ff_{};       // the inverse's memory follows the applied E
   double ff_stress_{0.0};  // T_hat at arm: the feedforward's static load
   double shaped_{0.0};
   double last_command_{0.0};

@@ -19,6 +19,8 @@ class Reconstruction;
 
 namespace selfsense::runtime {
 
+struct Feedforward;
+
 enum class CommandKind : std::uint8_t {
   kArm,
   kDisarm,
@@ -29,7 +31,8 @@ enum class CommandKind : std::uint8_t {
   kWave,       // wave (ownership passes to the loop)
   kStopWave,   // hold the wave's last value
   kGains,      // position, force
-  kSwapModel,  // model (ownership passes to the loop; its memory is carried over)
+  kSwapModel,  // model and, when not null, feedforward (ownership passes to the loop; the
+               // model takes the running one's memory); refused while armed
 };
 
 struct LoopCommand {
@@ -41,6 +44,7 @@ struct LoopCommand {
   models::Reconstruction* model{nullptr};
   control::Pid::Gains position{};
   control::Pid::Gains force{};
+  Feedforward* feedforward{nullptr};  // kSwapModel: the controller's new inverse model
 };
 
 enum class CommandResult : std::uint8_t {
@@ -60,6 +64,7 @@ struct LoopAnswer {
 struct Retired {
   control::WaveGenerator* wave{nullptr};
   models::Reconstruction* model{nullptr};
+  Feedforward* feedforward{nullptr};  // holds the inverse model it replaced
 };
 
 }  // namespace selfsense::runtime

@@ -49,6 +49,7 @@ struct OverrunPolicy {
   std::uint32_t within_count{10};  // >= 1
   std::uint32_t window{10000};     // cycles, >= within_count
   [[nodiscard]] bool is_valid(std::string* why) const;
+  friend bool operator==(const OverrunPolicy&, const OverrunPolicy&) = default;
 };
 
 struct FaultRecord {

@@ -3,7 +3,7 @@
 # (systemd/selfsensed.service) and a configuration like config/selfsensed.yaml. Checks that
 # `systemd-analyze verify` accepts the unit, that the service is active once it sent READY=1,
 # that it keeps itself alive through the watchdog, that a frozen daemon gets restarted by the
-# watchdog, and that `systemctl stop` ends it with status 0 after its safe-output shutdown.
+# watchdog, that a kill -9 of an armed daemon restarts it faulted, and that `systemctl stop` ends it with status 0 after its safe-output shutdown.
 # Prints "name=value" lines that tests/vm/daemon_systemd.sh checks.
 set -euo pipefail
 
@@ -76,6 +76,22 @@ echo "is-active_after_restart=$(systemctl is-active "$unit" || true)"
 if journalctl -b -u "$unit" --no-pager | grep -q 'Watchdog timeout'; then
   echo "watchdog_timeout_logged=yes"
 fi
+
+# kill -9 of an armed daemon: systemd restarts it (Restart=on-failure) and it comes up faulted,
+# never armed, whatever it was doing before.
+ctl() { selfsense ctl --socket "$sock" "$@"; }
+for _ in $(seq 40); do ctl status >/dev/null 2>&1 && break; sleep 0.5; done
+for _ in $(seq 20); do ctl reset >/dev/null 2>&1 && break; sleep 0.2; done
+echo "state_before_kill9=$(ctl arm 2>&1 | sed -n 's/.*"state":"\([a-z]*\)".*/\1/p')"
+restarts=$(prop NRestarts)
+systemctl kill --signal=KILL "$unit"
+for _ in $(seq 60); do
+  [ "$(prop NRestarts)" -gt "$restarts" ] && [ "$(systemctl is-active "$unit" || true)" = active ] && break
+  sleep 0.5
+done
+echo "restarted_after_kill9=$([ "$(prop NRestarts)" -gt "$restarts" ] && echo yes || echo no)"
+for _ in $(seq 40); do ctl status >/dev/null 2>&1 && break; sleep 0.5; done
+echo "state_after_kill9=$(ctl status 2>&1 | sed -n 's/.*"state":"\([a-z]*\)".*/\1/p')"
 
 systemctl stop "$unit" || fail "systemctl stop failed"
 echo "is-active_after_stop=$(systemctl is-active "$unit" || true)"
