@@ -39,8 +39,9 @@
 // Counters (DriverCounters): reads, writes; errors (failed transfers, GPIO errors, input-CRC
 // errors the ADC reported); timeouts (data-ready waits that timed out); stale; bad_data (reads
 // answered kBadData); retries (failed re-initialisation attempts); reconnects (successful
-// re-initialisations); device_faults (amplifier-fault assertions, ADC resets). SpiCounters has
-// the causes apart.
+// re-initialisations); device_faults (amplifier-fault assertions, ADC resets); crc_errors (ADC
+// frames with a bad CRC plus frames of ours the ADC rejected). SpiCounters has the causes apart;
+// counters() carries them as its events, under SpiCounters' field names.
 #pragma once
 
 #include <array>
