@@ -348,6 +348,7 @@ runtime::CycleTrigger::Result SpiDriver::wait(std::int64_t timeout_ns) noexcept 
     if (hw_.drdy->wait_edge(0, &edge) != EdgeWait::kEdge) break;
     bump(n_.drdy_missed);
   }
+  fired_ns_ = edge.timestamp_ns;
   return Result::kReady;
 }
 
