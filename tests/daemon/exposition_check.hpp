@@ -79,8 +79,12 @@ inline Exposition check_exposition(const std::string& text) {
         if ((*it)[1].str().rfind("__", 0) == 0) problem("reserved label name");
       }
       std::string key;
-      for (const auto& [k, val] : labels)
-        key += k + "=" + val + ";";
+      for (const auto& [k, val] : labels) {
+        key += k;
+        key += '=';
+        key += val;
+        key += ';';
+      }
       if (!x.samples[name].emplace(key, special ? std::nan("") : v).second)
         problem("two samples with the same labels");
       if (x.types[name] == "counter") {
