@@ -198,6 +198,11 @@ void CanDriver::on_frame(const canfd_frame& frame, std::int64_t now) noexcept {
       bump(n_.bus_off);
     }
     if ((frame.can_id & CAN_ERR_RESTARTED) != 0U && bus_off_.exchange(false)) bump(n_.reconnects);
+    // A protocol violation located in the CRC field: the controller saw a frame's CRC fail.
+    if ((frame.can_id & CAN_ERR_PROT) != 0U && frame.len > 3 &&
+        (frame.data[3] == CAN_ERR_PROT_LOC_CRC_SEQ || frame.data[3] == CAN_ERR_PROT_LOC_CRC_DEL)) {
+      bump(n_.crc_errors);
+    }
     if ((frame.can_id & CAN_ERR_CRTL) != 0U && frame.len > 1) {
       const std::uint8_t ctrl = frame.data[1];
       if ((ctrl & (CAN_ERR_CRTL_RX_PASSIVE | CAN_ERR_CRTL_TX_PASSIVE)) != 0U) {
@@ -383,6 +388,17 @@ runtime::DriverCounters CanDriver::counters() const noexcept {
   c.retries = get(n_.retries);
   c.reconnects = get(n_.reconnects);
   c.device_faults = get(n_.bus_off);
+  c.crc_errors = get(n_.crc_errors);
+  // The parts of the sums above, and what CanCounters keeps, under their own names.
+  c.add_event("rx_frames", get(n_.rx_frames));
+  c.add_event("error_frames", get(n_.error_frames));
+  c.add_event("tx_errors", get(n_.tx_errors));
+  c.add_event("tx_queue_full", get(n_.retries));
+  c.add_event("rx_timeouts", get(n_.timeouts));
+  c.add_event("bus_off_reads", get(n_.disconnected));
+  c.add_event("bus_off", get(n_.bus_off));
+  c.add_event("command_saturated", get(n_.saturated));
+  c.add_event("commands_superseded", get(n_.superseded));
   return c;
 }
 

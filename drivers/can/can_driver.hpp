@@ -23,7 +23,10 @@
 // Counters (DriverCounters): reads, writes (command frames sent by the bus thread), errors
 // (error frames received and failed sends), timeouts, stale (reads that returned those),
 // bad_data (input frames shorter than their signals need, dropped), retries (commands not sent
-// on a full TX queue), reconnects (recoveries from bus-off), device_faults (bus-off events).
+// on a full TX queue), reconnects (recoveries from bus-off), device_faults (bus-off events),
+// crc_errors (error frames reporting a protocol violation in the CRC sequence or delimiter).
+// Events (DriverCounters::events): rx_frames, error_frames, tx_errors, tx_queue_full,
+// rx_timeouts, bus_off_reads, bus_off, command_saturated, commands_superseded.
 #pragma once
 
 #include <linux/can.h>
@@ -152,7 +155,7 @@ class CanDriver final : public runtime::Driver {
   struct Atomics {
     std::atomic<std::uint64_t> reads{0}, writes{0}, tx_errors{0}, timeouts{0}, stale{0},
         bad_data{0}, retries{0}, reconnects{0}, bus_off{0}, rx_frames{0}, error_frames{0},
-        saturated{0}, disconnected{0}, superseded{0};
+        saturated{0}, disconnected{0}, superseded{0}, crc_errors{0};
   };
   Atomics n_{};
   std::atomic<bool> bus_off_{false};

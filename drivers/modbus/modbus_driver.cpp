@@ -193,6 +193,12 @@ runtime::DriverCounters ModbusDriver::counters() const noexcept {
   c.reconnects = reconnects_.load(std::memory_order_relaxed);
   c.bad_data = bad_data_.load(std::memory_order_relaxed);
   c.device_faults = device_faults_.load(std::memory_order_relaxed);
+  c.crc_errors = crc_errors_.load(std::memory_order_relaxed);
+  // The bus thread's figures that are counts (BusStats), and exceptions under their own name.
+  c.add_event("exception_responses", c.device_faults);
+  c.add_event("polls", polls_.load(std::memory_order_relaxed));
+  c.add_event("late_commands", late_commands_.load(std::memory_order_relaxed));
+  c.add_event("missed_deadlines", missed_deadlines_.load(std::memory_order_relaxed));
   return c;
 }
 
@@ -248,6 +254,7 @@ bool ModbusDriver::count_failure(int err) noexcept {
     modbus_flush(ctx_);
     return failures_in_row_ < config_.reconnect_after_failures;
   }
+  if (err == EMBBADCRC) bump(crc_errors_);
   if (err == EMBBADCRC || err == EMBBADDATA || err == EMBBADEXC || err == EMBUNKEXC ||
       err == EMBMDATA || err == EMBBADSLAVE) {
     bump(bad_data_);

@@ -32,6 +32,9 @@
 //   bad_data       answers with a CRC or framing error, wrong length, transaction or unit, and
 //                  values decoding to NaN or out of range
 //   device_faults  exception responses (the device refused: illegal address, function, ...)
+//   crc_errors     RTU answers whose CRC failed (also in bad_data; TCP has no CRC)
+// Events (DriverCounters::events): exception_responses, polls, late_commands,
+// missed_deadlines (BusStats' counts).
 #pragma once
 
 #include <atomic>
@@ -170,6 +173,7 @@ class ModbusDriver final : public runtime::Driver {
   std::atomic<std::uint64_t> reconnects_{0};
   std::atomic<std::uint64_t> bad_data_{0};
   std::atomic<std::uint64_t> device_faults_{0};
+  std::atomic<std::uint64_t> crc_errors_{0};
   std::atomic<std::uint64_t> polls_{0};
   std::atomic<std::uint64_t> poll_ns_sum_{0};
   std::atomic<std::uint64_t> poll_ns_max_{0};

@@ -60,6 +60,16 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
   out.t_ref = o.t_pa;
   out.timestamp_ns = static_cast<std::int64_t>(std::llround(o.t_s * 1e9));
   out.device_status = static_cast<std::uint16_t>(status & 0xffffU);
+  // Each fault flag of the cycle counts under its own name (the status below takes the first).
+  const auto flagged = [status](std::uint32_t bit, std::uint64_t& n) {
+    if ((status & bit) != 0U) ++n;
+  };
+  flagged(plant::kAmplifierFault, causes_.amplifier_fault);
+  flagged(plant::kStuckAdc, causes_.stuck_adc);
+  flagged(plant::kMissedDataReady, causes_.missed_data_ready);
+  flagged(plant::kNanSample, causes_.nan_sample);
+  flagged(plant::kOutOfRange, causes_.out_of_range);
+  flagged(plant::kSensorDisconnect, causes_.sensor_disconnect);
   if ((status & plant::kAmplifierFault) != 0U) {
     ++counters_.device_faults;
     return runtime::DriverStatus::kDeviceFault;
@@ -88,7 +98,14 @@ void SimulatedTransducer::deactivate() noexcept {
 }
 
 runtime::DriverCounters SimulatedTransducer::counters() const noexcept {
-  return counters_;
+  runtime::DriverCounters c = counters_;
+  c.add_event("amplifier_fault_cycles", causes_.amplifier_fault);
+  c.add_event("stuck_adc_cycles", causes_.stuck_adc);
+  c.add_event("missed_data_ready_cycles", causes_.missed_data_ready);
+  c.add_event("nan_sample_cycles", causes_.nan_sample);
+  c.add_event("out_of_range_cycles", causes_.out_of_range);
+  c.add_event("sensor_disconnect_cycles", causes_.sensor_disconnect);
+  return c;
 }
 
 bool SimulatedTransducer::inject(plant::FaultKind kind, plant::Channel channel,

@@ -11,7 +11,11 @@
 // Faults: a plant status bit raised in any of the cycle's plant samples becomes a driver
 // status: stuck ADC and missed data-ready -> kStale, NaN, out-of-range and disconnected
 // channels -> kBadData (the values are passed on too, so the loop's own checks see them),
-// amplifier fault line -> kDeviceFault.
+// amplifier fault line -> kDeviceFault. counters() adds, as events, the cycles in which each
+// fault flag was raised (`amplifier_fault_cycles`, `stuck_adc_cycles`,
+// `missed_data_ready_cycles`, `nan_sample_cycles`, `out_of_range_cycles`,
+// `sensor_disconnect_cycles`); counters() reads plain fields: call it from the loop's thread
+// (the loop does, for its status snapshot).
 //
 // read(), write(), inject(), set_external_force() are real-time safe.
 #pragma once
@@ -62,6 +66,16 @@ class SimulatedTransducer final : public runtime::Driver {
   std::int64_t cycles_{0};
   std::atomic<double> force_n_{0.0};
   runtime::DriverCounters counters_{};
+  // Cycles in which each plant fault flag was raised (counters() events *_cycles).
+  struct Causes {
+    std::uint64_t amplifier_fault{0};
+    std::uint64_t stuck_adc{0};
+    std::uint64_t missed_data_ready{0};
+    std::uint64_t nan_sample{0};
+    std::uint64_t out_of_range{0};
+    std::uint64_t sensor_disconnect{0};
+  };
+  Causes causes_{};
 };
 
 }  // namespace selfsense::drivers

@@ -348,6 +348,7 @@ runtime::CycleTrigger::Result SpiDriver::wait(std::int64_t timeout_ns) noexcept 
     if (hw_.drdy->wait_edge(0, &edge) != EdgeWait::kEdge) break;
     bump(n_.drdy_missed);
   }
+  fired_ns_ = edge.timestamp_ns;
   return Result::kReady;
 }
 
@@ -400,6 +401,21 @@ runtime::DriverCounters SpiDriver::counters() const noexcept {
   c.retries = get(n_.reinit_failures);
   c.reconnects = get(n_.reinits);
   c.device_faults = get(n_.amp_faults) + get(n_.adc_resets);
+  c.crc_errors = get(n_.crc_errors) + get(n_.input_crc_errors);
+  // Every cause apart (SpiCounters), under the same names.
+  const SpiCounters s = spi_counters();
+  c.add_event("crc_errors", s.crc_errors);
+  c.add_event("input_crc_errors", s.input_crc_errors);
+  c.add_event("clipped", s.clipped);
+  c.add_event("out_of_range", s.out_of_range);
+  c.add_event("no_new_data", s.no_new_data);
+  c.add_event("stuck", s.stuck);
+  c.add_event("drdy_missed", s.drdy_missed);
+  c.add_event("command_clipped", s.command_clipped);
+  c.add_event("amp_faults", s.amp_faults);
+  c.add_event("adc_resets", s.adc_resets);
+  c.add_event("reinit_failures", s.reinit_failures);
+  c.add_event("reinits", s.reinits);
   return c;
 }
 

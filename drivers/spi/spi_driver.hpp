@@ -39,8 +39,9 @@
 // Counters (DriverCounters): reads, writes; errors (failed transfers, GPIO errors, input-CRC
 // errors the ADC reported); timeouts (data-ready waits that timed out); stale; bad_data (reads
 // answered kBadData); retries (failed re-initialisation attempts); reconnects (successful
-// re-initialisations); device_faults (amplifier-fault assertions, ADC resets). SpiCounters has
-// the causes apart.
+// re-initialisations); device_faults (amplifier-fault assertions, ADC resets); crc_errors (ADC
+// frames with a bad CRC plus frames of ours the ADC rejected). SpiCounters has the causes apart;
+// counters() carries them as its events, under SpiCounters' field names.
 #pragma once
 
 #include <array>
@@ -137,6 +138,8 @@ class SpiDriver final : public runtime::Driver, private runtime::CycleTrigger {
 
  private:
   Result wait(std::int64_t timeout_ns) noexcept override;  // runtime::CycleTrigger
+  // The newest data-ready edge the last wait() took (runtime::CycleTrigger).
+  [[nodiscard]] std::int64_t fired_ns() const noexcept override { return fired_ns_; }
   // Resets and configures the ADC; false with *why. Maintenance thread or activate().
   bool initialise_adc(std::string* why) noexcept;
   // Sends command (+ data) in one frame and returns the answer from the next (NULL) frame.
@@ -179,6 +182,7 @@ class SpiDriver final : public runtime::Driver, private runtime::CycleTrigger {
   std::int32_t last_e_code_{0};
   std::int32_t last_d_code_{0};
   std::int64_t read_ns_{0};
+  std::int64_t fired_ns_{-1};
   runtime::LatencyHistogram read_to_write_{};
 
   // Maintenance thread only.

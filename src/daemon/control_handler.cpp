@@ -99,7 +99,15 @@ nlohmann::json ControlHandler::status() {
       {"driver_device_faults", s.driver.device_faults},
       {"driver_retries", s.driver.retries},
       {"driver_reconnects", s.driver.reconnects},
+      {"driver_writes", s.driver.writes},
+      {"driver_crc_errors", s.driver.crc_errors},
   };
+  // The driver's own counters under their names (docs/drivers/*.md), e.g. spi's no_new_data.
+  nlohmann::json driver_events = nlohmann::json::object();
+  for (const runtime::NamedCount& e : s.driver.event_list()) {
+    if (e.name != nullptr) driver_events[e.name] = e.value;
+  }
+  counters["driver_events"] = driver_events;
   nlohmann::json estimate_status = nlohmann::json::object();
   for (std::size_t i = 0; i < models::kSampleStatusCount; ++i) {
     estimate_status[std::string(models::to_string(static_cast<models::SampleStatus>(i)))] =
@@ -114,6 +122,7 @@ nlohmann::json ControlHandler::status() {
   return ok_reply({
       {"state", runtime::to_string(s.state)},
       {"mode", std::string(mode_name(s.mode))},
+      {"driver", std::string(daemon_->driver().name())},
       {"faults", faults},
       {"fault_details", fault_details},
       {"counters", counters},

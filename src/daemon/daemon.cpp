@@ -14,6 +14,8 @@
 
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/daemon/prometheus.hpp"
+#include "selfsense/daemon/recorder_metrics.hpp"
+#include "selfsense/daemon/telemetry_metrics.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/models/model_identity.hpp"
 #include "selfsense/models/runtime_model.hpp"
@@ -282,23 +284,13 @@ void Daemon::notify_status() {
 void Daemon::write_telemetry() {
   if (config_.telemetry.prometheus_file.empty()) return;
   const runtime::StatusSnapshot s = loop_->status();
-  std::string text;
-  const auto gauge = [&](const char* name, const char* help, double v) {
-    text += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " gauge\n" + name +
-            " " + std::to_string(v) + "\n";
-  };
-  gauge("selfsense_loop_state", "0 faulted, 1 ready, 2 armed", static_cast<double>(s.state));
-  gauge("selfsense_loop_cycles", "loop cycles since start", static_cast<double>(s.cycle));
-  gauge("selfsense_loop_faults_latched", "latched fault bits", static_cast<double>(s.faults));
-  gauge("selfsense_loop_overruns", "missed deadlines", static_cast<double>(s.overruns));
-  gauge("selfsense_loop_wake_latency_p99_seconds", "wake-up latency p99",
-        static_cast<double>(s.wake_latency_p99_ns) * 1e-9);
-  gauge("selfsense_loop_cycle_time_p99_seconds", "cycle execution time p99",
-        static_cast<double>(s.cycle_time_p99_ns) * 1e-9);
-  gauge("selfsense_loop_samples_dropped", "samples the recorder could not take",
-        static_cast<double>(s.samples_dropped));
   try {
-    write_textfile(config_.telemetry.prometheus_file, text);
+    std::vector<MetricFamily> families = loop_metrics(s);
+    for (MetricFamily& f : driver_metrics(driver_->name(), s.driver))
+      families.push_back(std::move(f));
+    for (MetricFamily& f : recorder_metrics(recorder_->counters()))
+      families.push_back(std::move(f));
+    write_textfile(config_.telemetry.prometheus_file, format_exposition(families));
   } catch (const std::exception& e) {
     static_cast<void>(std::fprintf(stderr, "selfsensed: telemetry: %s\n", e.what()));
   }

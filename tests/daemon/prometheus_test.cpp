@@ -7,8 +7,11 @@
 #include <iterator>
 #include <thread>
 
+#include "daemon/exposition_check.hpp"
 #include "daemon/recording_support.hpp"
 #include "selfsense/daemon/recorder_metrics.hpp"
+#include "selfsense/daemon/telemetry_metrics.hpp"
+#include "selfsense/runtime/supervisor.hpp"
 
 namespace selfsense::daemon {
 namespace {
@@ -109,6 +112,81 @@ TEST(Prometheus, RecorderCountersBecomeValidMetrics) {
   EXPECT_NE(text.find("# TYPE selfsense_recorder_recording gauge\n"
                       "selfsense_recorder_recording{board=\"b1\"} 1\n"),
             std::string::npos);
+}
+
+std::string joined(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const std::string& l : lines)
+    out += l + "\n";
+  return out;
+}
+
+// The checker itself finds each kind of mistake (else the test below could pass on bad text).
+TEST(Prometheus, TheExpositionCheckerFindsMistakes) {
+  const auto problems = [](const std::string& text) {
+    return test::check_exposition(text).problems.size();
+  };
+  const std::string good =
+      "# HELP a_total A.\n# TYPE a_total counter\na_total{x=\"1\"} 2\na_total{x=\"2\"} 3\n";
+  EXPECT_EQ(problems(good), 0U) << joined(test::check_exposition(good).problems);
+  EXPECT_EQ(problems("a_total 1\n"), 1U);                                    // no HELP/TYPE
+  EXPECT_EQ(problems("# HELP b B.\n# TYPE b gauge\nb one\n"), 1U);           // not a number
+  EXPECT_EQ(problems("# HELP b-c B.\n"), 1U);                                // bad name
+  EXPECT_EQ(problems("# HELP b B.\n# TYPE b counter\nb 1\n"), 1U);           // counter not _total
+  EXPECT_EQ(problems("# HELP b B.\n# TYPE b gauge\nb{__x=\"1\"} 1\n"), 1U);  // reserved label
+  EXPECT_EQ(problems(good + "# HELP c C.\n# TYPE c gauge\nc 1\na_total{x=\"3\"} 1\n"),
+            1U);                                                       // two blocks
+  EXPECT_EQ(problems("# HELP b B.\n# TYPE b gauge\nb 1\nb 2\n"), 1U);  // same labels twice
+  EXPECT_EQ(problems("# HELP b B.\n# TYPE b gauge\nb 1"), 1U);         // no final line feed
+}
+
+// Every family the daemon's telemetry file holds, formatted: valid exposition text, and the
+// driver's counters, fault counts and recorder counters in it under their names.
+TEST(Prometheus, TelemetryFamiliesAreValidExposition) {
+  runtime::StatusSnapshot s;
+  s.cycle = 123456;
+  s.state = runtime::LoopState::kArmed;
+  s.fault_records[static_cast<std::size_t>(runtime::Fault::kDriverError)].count = 4;
+  s.wake_latency_p99_ns = 25'000;
+  s.driver.reads = 1000;
+  s.driver.crc_errors = 7;
+  s.driver.add_event("no_new_data", 3);
+  s.driver.add_event("reinits", 1);
+  s.driver.add_event("no_new_data", 9);  // a repeated name is left out, not a second series
+  s.driver.add_event(nullptr, 5);        // so is a missing one
+  RecorderCounters rec;
+  rec.rows_written = 42;
+  rec.samples_dropped = 2;
+  std::vector<MetricFamily> families = loop_metrics(s);
+  for (MetricFamily& f : driver_metrics("spi", s.driver))
+    families.push_back(std::move(f));
+  for (MetricFamily& f : recorder_metrics(rec))
+    families.push_back(std::move(f));
+  const std::string text = format_exposition(families);
+  const test::Exposition x = test::check_exposition(text);
+  EXPECT_TRUE(x.problems.empty()) << joined(x.problems) << text;
+  const auto value = [&](const std::string& name, const std::string& labels) {
+    const auto f = x.samples.find(name);
+    if (f == x.samples.end()) return -1.0;
+    const auto v = f->second.find(labels);
+    return v == f->second.end() ? -1.0 : v->second;
+  };
+  EXPECT_EQ(value("selfsense_driver_crc_errors_total", "driver=spi;"), 7.0);
+  EXPECT_EQ(value("selfsense_driver_reads_total", "driver=spi;"), 1000.0);
+  EXPECT_EQ(value("selfsense_driver_events_total", "driver=spi;event=no_new_data;"), 3.0);
+  EXPECT_EQ(value("selfsense_driver_events_total", "driver=spi;event=reinits;"), 1.0);
+  EXPECT_EQ(x.samples.at("selfsense_driver_events_total").size(), 2U);
+  EXPECT_EQ(value("selfsense_loop_faults_total", "fault=driver_error;"), 4.0);
+  EXPECT_EQ(value("selfsense_loop_faults_total", "fault=watchdog;"), 0.0);
+  EXPECT_EQ(x.samples.at("selfsense_loop_faults_total").size(), runtime::kFaultCount);
+  EXPECT_EQ(value("selfsense_loop_cycles", ""), 123456.0);
+  EXPECT_EQ(value("selfsense_loop_state", ""), 2.0);
+  EXPECT_DOUBLE_EQ(value("selfsense_loop_wake_latency_p99_seconds", ""), 25e-6);
+  EXPECT_EQ(value("selfsense_recorder_rows_written_total", ""), 42.0);
+  EXPECT_EQ(value("selfsense_recorder_samples_dropped_total", ""), 2.0);
+  EXPECT_EQ(x.types.at("selfsense_driver_events_total"), "counter");
+  EXPECT_EQ(x.types.at("selfsense_loop_faults_total"), "counter");
+  EXPECT_EQ(x.types.at("selfsense_loop_cycles"), "gauge");
 }
 
 }  // namespace

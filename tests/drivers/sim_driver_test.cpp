@@ -29,6 +29,16 @@ TEST(SimulatedTransducer, AFaultInAnyPlantSampleOfTheCycleIsReported) {
   EXPECT_EQ(driver.read(sample), runtime::DriverStatus::kBadData);
   EXPECT_EQ(driver.read(sample), runtime::DriverStatus::kOk);
   EXPECT_EQ(driver.counters().bad_data, 1U);
+  // The cause, by name, among the driver's events (status counters.driver_events).
+  const runtime::DriverCounters c = driver.counters();
+  std::uint64_t nan_cycles = 0;
+  std::uint64_t others = 0;
+  for (const runtime::NamedCount& e : c.event_list()) {
+    (std::string(e.name) == "nan_sample_cycles" ? nan_cycles : others) += e.value;
+  }
+  EXPECT_EQ(c.event_list().size(), 6U);
+  EXPECT_EQ(nan_cycles, 1U);
+  EXPECT_EQ(others, 0U);
 }
 
 }  // namespace

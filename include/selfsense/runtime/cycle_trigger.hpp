@@ -26,6 +26,10 @@ class CycleTrigger {
 
   // Blocks until the next trigger or timeout_ns have passed.
   virtual Result wait(std::int64_t timeout_ns) noexcept = 0;
+  // When the trigger that ended the last kReady wait fired (the data-ready edge's kernel time
+  // stamp), on the clock of the thread that waits (CLOCK_MONOTONIC on the target); -1 when the
+  // trigger does not know. LoopRunner measures its wake-up latency from it.
+  [[nodiscard]] virtual std::int64_t fired_ns() const noexcept { return -1; }
 };
 
 }  // namespace selfsense::runtime

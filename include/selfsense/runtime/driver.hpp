@@ -13,8 +13,11 @@
 // report through a status code, never an exception.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -51,8 +54,21 @@ struct DriverSetup {
   double sample_time{0.0};  // [s] of the loop
 };
 
-// Counters a driver keeps (read from any thread; the owning driver writes them).
+// One counter a driver keeps beyond the common ones, under the driver's own name. The name is a
+// string literal (static storage, never freed), so DriverCounters stays trivially copyable and
+// crosses the loop's status seqlock as plain words, and filling it allocates nothing.
+struct NamedCount {
+  const char* name{nullptr};  // lower_snake_case, unique within the driver
+  std::uint64_t value{0};
+};
+
+// Counters a driver keeps (read from any thread; the owning driver writes them). The common
+// fields mean the same for every driver (docs/drivers/*.md say what each driver counts in
+// them); `events` carries every other counter the driver keeps, so that all of them reach the
+// daemon's status (`counters.driver_events`) and telemetry (selfsense_driver_events_total).
 struct DriverCounters {
+  static constexpr std::size_t kMaxEvents = 16;
+
   std::uint64_t reads{0};
   std::uint64_t writes{0};
   std::uint64_t errors{0};
@@ -62,6 +78,20 @@ struct DriverCounters {
   std::uint64_t retries{0};
   std::uint64_t reconnects{0};
   std::uint64_t device_faults{0};
+  std::uint64_t crc_errors{0};  // frames whose checksum failed, either direction (0: no CRC)
+  std::array<NamedCount, kMaxEvents> events{};
+  std::size_t event_count{0};
+
+  // Appends a driver-specific counter; false (and nothing stored) when all kMaxEvents slots are
+  // taken. Real-time safe.
+  bool add_event(const char* name, std::uint64_t value) noexcept {
+    if (event_count >= kMaxEvents) return false;
+    events[event_count++] = NamedCount{name, value};
+    return true;
+  }
+  [[nodiscard]] std::span<const NamedCount> event_list() const noexcept {
+    return {events.data(), event_count};
+  }
 };
 
 class Driver {
@@ -83,6 +113,10 @@ class Driver {
 
   // Whether read() fills s_ref and t_ref.
   [[nodiscard]] virtual bool has_references() const noexcept { return false; }
+  // Every counter the driver keeps, the common ones and its own (events). The loop calls it on
+  // its real-time thread every status_period cycles for the status snapshot: real-time safe
+  // (loads of atomics, nothing allocated, no lock), and the same event names in the same order
+  // on every call.
   [[nodiscard]] virtual DriverCounters counters() const noexcept = 0;
   // When the device paces the loop (its data-ready edge starts each cycle), the trigger to wait
   // on instead of the timer; null otherwise (the default). Valid while the driver is active.

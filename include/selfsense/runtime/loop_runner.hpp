@@ -3,7 +3,9 @@
 // edge), to the trigger: each cycle starts when it fires, and a trigger that does not fire within
 // two periods counts as an overrun and the cycle runs anyway (its read() reports the missing
 // sample, the supervisor faults). Each cycle's execution time and wake-up latency are measured and
-// published with the loop's status. progress() counts finished cycles: the daemon pings the
+// published with the loop's status; paced by a trigger, the wake-up latency runs from the
+// trigger's time stamp (CycleTrigger::fired_ns(), the data-ready edge) to the wake-up, for the
+// triggers that give one (else it stays 0). progress() counts finished cycles: the daemon pings the
 // systemd watchdog only while it advances, so a stalled loop gets the service restarted.
 //
 //   start()  spawns the thread (not real-time); stop() asks it to finish its cycle and joins.

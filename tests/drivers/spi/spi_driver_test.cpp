@@ -8,6 +8,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "selfsense/runtime/driver.hpp"
 #include "support/allocation_counter.hpp"
@@ -139,6 +140,33 @@ TEST(SpiDriver, CrcErrorsAreCountedFaultsAndThreeInARowReinitialiseTheAdc) {
   EXPECT_EQ(f.bench->driver.counters().reconnects, 1U);
   EXPECT_EQ(f.cycle(), DriverStatus::kOk);
   EXPECT_EQ(f.bench->driver.spi_counters().crc_errors, 4U);
+}
+
+// Every cause SpiCounters keeps reaches counters() as an event under its field's name (the
+// daemon's status and telemetry show nothing else), and CRC errors in the common field.
+TEST(SpiDriver, CountersCarryEveryCauseAsANamedEvent) {
+  Fixture f;
+  ASSERT_TRUE(f.start());
+  ASSERT_EQ(f.cycle(), DriverStatus::kOk);
+  f.bench->adc.inject_crc_errors(2);
+  EXPECT_EQ(f.cycle(), DriverStatus::kBadData);
+  EXPECT_EQ(f.cycle(), DriverStatus::kBadData);
+  EXPECT_EQ(f.cycle(), DriverStatus::kOk);
+  const runtime::DriverCounters c = f.bench->driver.counters();
+  EXPECT_EQ(c.crc_errors, 2U);
+  const std::vector<std::string> names{"crc_errors",   "input_crc_errors", "clipped",
+                                       "out_of_range", "no_new_data",      "stuck",
+                                       "drdy_missed",  "command_clipped",  "amp_faults",
+                                       "adc_resets",   "reinit_failures",  "reinits"};
+  ASSERT_EQ(c.event_list().size(), names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    ASSERT_NE(c.events[i].name, nullptr);
+    EXPECT_EQ(std::string(c.events[i].name), names[i]);
+  }
+  EXPECT_EQ(c.events[0].value, 2U);
+  EXPECT_EQ(c.events[1].value, 0U);
+  // The same names in the same order on every call (the status keeps them as published).
+  EXPECT_EQ(std::string(f.bench->driver.counters().events[11].name), "reinits");
 }
 
 TEST(SpiDriver, FailedReinitialisationsRetryWithBackOffAndAreCounted) {

@@ -158,5 +158,25 @@ TEST(SpiLoop, LoopRunnerIsPacedByDataReady) {
   EXPECT_EQ(b.spi->driver.counters().timeouts, 0U);
 }
 
+// Paced by data-ready, the status' wake-up latency runs from the edge's time stamp to the
+// runner's wake-up: every wait here returns 7 us after its edge (the simulated clock's sleeps
+// end late), and that is what the status shows.
+TEST(SpiLoop, TheWakeUpLatencyRunsFromTheDataReadyEdge) {
+  LoopBench b;
+  b.spi->clock.set_wake_latency_ns(7'000);
+  runtime::LoopRunner runner(*b.loop, b.spi->clock, 100'000, runtime::RtOptions{0, -1, 0, 0},
+                             b.spi->driver.cycle_trigger());
+  static_cast<void>(runner.start());
+  while (runner.progress() < 3000)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  runner.stop();
+  const runtime::StatusSnapshot s = b.loop->status();
+  EXPECT_EQ(s.wake_latency_max_ns, 7'000);
+  EXPECT_GE(s.wake_latency_p50_ns, 7'000);  // a bucket's upper bound
+  EXPECT_LE(s.wake_latency_p50_ns, 8'000);
+  EXPECT_EQ(s.overruns, 0);
+  EXPECT_EQ(b.spi->driver.spi_counters().drdy_missed, 0U);
+}
+
 }  // namespace
 }  // namespace selfsense::test
