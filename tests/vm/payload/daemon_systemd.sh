@@ -23,9 +23,10 @@ mkdir -p /etc/selfsense/models /etc/selfsense/plant
 cp "$files/config/models/sim.yaml" /etc/selfsense/models/
 cp "$files/config/plant/daemon.yaml" /etc/selfsense/plant/
 # Software emulation is far from real time: a 1 kHz loop, degraded timing allowed, overruns
-# tolerated (this test is about systemd, not timing).
+# tolerated, also as faults, so that the loop can be armed (this test is about systemd, not timing).
 sed -e 's/rate_hz: 10000/rate_hz: 1000/' -e 's/frequency_hz: 2000.0/frequency_hz: 300.0/' \
   -e 's/allow_degraded_timing: false/allow_degraded_timing: true/' \
+  -e 's/^safety:$/safety:\n  overrun: {consecutive: 1000000, within_count: 64, window_cycles: 64}/' \
   "$files/config/selfsensed.yaml" >/etc/selfsense/selfsensed.yaml
 selfsense check-config /etc/selfsense/selfsensed.yaml || fail "check-config rejected the configuration"
 
