@@ -11,7 +11,8 @@
 // Faults: a plant status bit raised in any of the cycle's plant samples becomes a driver
 // status: stuck ADC and missed data-ready -> kStale, NaN, out-of-range and disconnected
 // channels -> kBadData (the values are passed on too, so the loop's own checks see them),
-// amplifier fault line -> kDeviceFault.
+// amplifier fault line -> kDeviceFault, a sample late by a loop period or more -> kTimeout (it
+// missed its cycle; one late by less arrived within it and only shows in the status bits).
 //
 // read(), write(), inject(), set_external_force() are real-time safe.
 #pragma once
