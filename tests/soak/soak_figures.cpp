@@ -11,6 +11,20 @@ namespace {
 
 constexpr double kMib = 1024.0 * 1024.0;
 
+// AddressSanitizer keeps freed memory in its quarantine (up to 256 MiB) before reusing it, so the
+// daemon's resident memory grows under it by design: measured there, asserted in other builds.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
 std::uint64_t counter(const nlohmann::json& status, const char* name) {
   const auto& c = status.value("counters", nlohmann::json::object());
   return c.contains(name) && c[name].is_number_unsigned() ? c[name].get<std::uint64_t>() : ~0ULL;
@@ -88,7 +102,7 @@ void judge_rss(Report& r) {
   r.rss_baseline_mib = baseline;
   r.rss_final_mib = final;
   r.rss_slope_kib_per_min = (n * sxy - sx * sy) / (n * sxx - sx * sx) * 1024.0 * 60.0;
-  if (final > baseline + kRssGrowthMaxMib) {
+  if (final > baseline + kRssGrowthMaxMib && !kAddressSanitizer) {
     r.failures.push_back("resident memory grew from " + std::to_string(baseline) + " MiB to " +
                          std::to_string(final) + " MiB");
   }
@@ -245,8 +259,9 @@ void print_report(const Report& r, std::ostream& out) {
       static_cast<long long>(timing["cycle_time_ns"].value("max", -1LL)));
   line(
       "memory: RSS %.1f MiB (20-45 %% of the run, max) -> %.1f MiB (last quarter, max), "
-      "slope %.1f KiB/min after 20 %%",
-      r.rss_baseline_mib, r.rss_final_mib, r.rss_slope_kib_per_min);
+      "slope %.1f KiB/min after 20 %%%s",
+      r.rss_baseline_mib, r.rss_final_mib, r.rss_slope_kib_per_min,
+      kAddressSanitizer ? " (not asserted: AddressSanitizer's quarantine)" : "");
   for (const std::string& f : r.failures)
     out << "FAIL: " << f << '\n';
   out << (r.failures.empty() ? "soak: ok\n" : "soak: FAILED\n");
