@@ -162,6 +162,9 @@ case "$mode" in
     CXX=clang++ configure_and_build build-sanitize -DCMAKE_BUILD_TYPE=Debug -DSELFSENSE_WERROR=ON \
       -DSELFSENSE_SANITIZE=address,undefined -DSELFSENSE_BUILD_BENCHMARKS=OFF -DSELFSENSE_FUZZ=ON
     # The accuracy figures are checked in the Release run; under the sanitizers they only cost time.
+    # The soak test (label soak) stays: under ASan + UBSan the daemon held 10 kHz for its 75 s
+    # (0.8 % of deadlines missed, all counted; docs/reliability.md), and ASan checks the daemon
+    # under hostile clients; only its memory limit is not asserted there (ASan's quarantine).
     run_tests build-sanitize -LE 'accuracy|vm'
     say "fuzz: every target for ${FUZZ_SECONDS:-10} s on a copy of its corpus"
     run_fuzz build-sanitize

@@ -1,5 +1,6 @@
 #include "sim/simulated_transducer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -49,9 +50,11 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
   // The plant may run several steps per loop cycle; a fault flag raised in any of them is the
   // device's (like the sticky bits of a status register), not only one in the step read last.
   std::uint32_t status = 0;
+  double latency_s = 0.0;
   for (int i = 0; i < substeps_; ++i) {
     o = plant_->step(input);
     status |= o.status;
+    latency_s = std::max(latency_s, o.latency_s);
   }
   ++cycles_;
   out.e = o.e_meas_v_per_m;
@@ -73,6 +76,11 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
   if ((status & plant::kAmplifierFault) != 0U) {
     ++counters_.device_faults;
     return runtime::DriverStatus::kDeviceFault;
+  }
+  // A sample delivered a loop period or more after its sampling instant missed its cycle.
+  if (latency_s >= sample_time_) {
+    ++counters_.timeouts;
+    return runtime::DriverStatus::kTimeout;
   }
   if ((status & (plant::kStuckAdc | plant::kMissedDataReady)) != 0U) {
     ++counters_.stale;

@@ -11,11 +11,12 @@
 // Faults: a plant status bit raised in any of the cycle's plant samples becomes a driver
 // status: stuck ADC and missed data-ready -> kStale, NaN, out-of-range and disconnected
 // channels -> kBadData (the values are passed on too, so the loop's own checks see them),
-// amplifier fault line -> kDeviceFault. counters() adds, as events, the cycles in which each
-// fault flag was raised (`amplifier_fault_cycles`, `stuck_adc_cycles`,
-// `missed_data_ready_cycles`, `nan_sample_cycles`, `out_of_range_cycles`,
-// `sensor_disconnect_cycles`); counters() reads plain fields: call it from the loop's thread
-// (the loop does, for its status snapshot).
+// amplifier fault line -> kDeviceFault, a sample late by a loop period or more -> kTimeout (it
+// missed its cycle; one late by less arrived within it and only shows in the status bits).
+// counters() adds, as events, the cycles in which each fault flag was raised
+// (`amplifier_fault_cycles`, `stuck_adc_cycles`, `missed_data_ready_cycles`,
+// `nan_sample_cycles`, `out_of_range_cycles`, `sensor_disconnect_cycles`); counters() reads
+// plain fields: call it from the loop's thread (the loop does, for its status snapshot).
 //
 // read(), write(), inject(), set_external_force() are real-time safe.
 #pragma once

@@ -134,7 +134,10 @@ void Loop::handle(const LoopCommand& c) noexcept {
       last_feed_ = cycle_;
       return answer(c, CommandResult::kDone);
     case CommandKind::kStopWave:
-      if (wave_running_) hold_setpoint_ = last_wave_value_;
+      if (wave_running_) {
+        hold_setpoint_ = last_wave_value_;
+        last_feed_ = cycle_;  // the watchdog counts the hold from here, not from the wave's start
+      }
       wave_running_ = false;
       return answer(c, CommandResult::kDone);
     case CommandKind::kGains:
@@ -164,6 +167,7 @@ double Loop::setpoint() noexcept {
     if (wave_->done()) {
       hold_setpoint_ = v;
       wave_running_ = false;
+      last_feed_ = cycle_;  // as a stop: the hold starts now
     }
     return v;
   }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "selfsense/plant/config.hpp"
+#include "selfsense/plant/status.hpp"
 #include "sim/simulated_transducer.hpp"
 
 namespace selfsense::drivers {
@@ -39,6 +40,31 @@ TEST(SimulatedTransducer, AFaultInAnyPlantSampleOfTheCycleIsReported) {
   EXPECT_EQ(c.event_list().size(), 6U);
   EXPECT_EQ(nan_cycles, 1U);
   EXPECT_EQ(others, 0U);
+}
+
+// A late sample used to pass as kOk (the plant flagged it, the driver mapped nothing): found by
+// the soak test (tests/soak), which injects every plant fault kind into the running daemon.
+TEST(SimulatedTransducer, ASampleLateByALoopPeriodIsATimeoutAndOneLateByLessIsNot) {
+  plant::PlantConfig config;
+  config.sample_rate_hz = kPlantRateHz;
+  const double period = 1.0 / kLoopRateHz;
+  // Cycle 2 (plant samples 4..7): late by half a period; cycle 4 (12..15): by a whole one.
+  config.faults.push_back(plant::FaultEntry{plant::FaultKind::late_sample, plant::Channel::both,
+                                            5.0 / kPlantRateHz, 0.0, 0.5 * period});
+  config.faults.push_back(plant::FaultEntry{plant::FaultKind::late_sample, plant::Channel::both,
+                                            13.0 / kPlantRateHz, 0.0, period});
+  SimulatedTransducer driver(config);
+  std::string why;
+  ASSERT_TRUE(driver.configure(runtime::DriverSetup{period}, &why)) << why;
+  ASSERT_TRUE(driver.activate(&why)) << why;
+  runtime::InputSample sample{};
+  EXPECT_EQ(driver.read(sample), runtime::DriverStatus::kOk);
+  EXPECT_EQ(driver.read(sample), runtime::DriverStatus::kOk);
+  EXPECT_NE(sample.device_status & plant::kLateSample, 0U);
+  EXPECT_EQ(driver.read(sample), runtime::DriverStatus::kOk);
+  EXPECT_EQ(driver.read(sample), runtime::DriverStatus::kTimeout);
+  EXPECT_EQ(driver.read(sample), runtime::DriverStatus::kOk);
+  EXPECT_EQ(driver.counters().timeouts, 1U);
 }
 
 }  // namespace

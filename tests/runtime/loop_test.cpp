@@ -333,5 +333,41 @@ TEST(Loop, OverrunPolicyAndWatchdogFault) {
   EXPECT_EQ(b.loop->local_status().last.command, 0.0);
 }
 
+// A wave that ended or was stopped after playing longer than the watchdog used to fault in the
+// next cycle (the watchdog counted from the wave's request); found by the soak test (tests/soak).
+TEST(Loop, TheWatchdogCountsTheHoldFromTheEndOfAWave) {
+  LoopConfig lc;
+  lc.watchdog_s = 0.05;
+  Bench b(test::daemon_plant(kRate), bench_control(), lc);
+  start(b, ControlMode::kPosition);
+  control::WaveGenerator::Config stopped{};
+  stopped.amplitude = 2e-4;
+  stopped.offset = 5e-4;
+  stopped.frequency = 5.0;
+  LoopCommand wave{0, CommandKind::kWave};
+  wave.wave = new control::WaveGenerator(stopped, kTs);  // NOLINT(cppcoreguidelines-owning-memory)
+  ASSERT_EQ(b.send(wave), CommandResult::kDone);
+  b.run(0.2);  // four watchdog periods of wave
+  ASSERT_EQ(b.send({0, CommandKind::kStopWave}), CommandResult::kDone);
+  b.run(0.04);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed) << "faulted on the wave's stop";
+  b.run(0.02);
+  EXPECT_NE(b.loop->supervisor().latched() & bit(Fault::kWatchdog), 0U);
+
+  ASSERT_EQ(b.send({0, CommandKind::kReset}), CommandResult::kDone);
+  ASSERT_EQ(b.send({0, CommandKind::kArm}), CommandResult::kDone);
+  control::WaveGenerator::Config finite = stopped;
+  finite.repeats = 1;                                   // ends by itself after 0.2 s
+  wave.wave = new control::WaveGenerator(finite, kTs);  // NOLINT(cppcoreguidelines-owning-memory)
+  ASSERT_EQ(b.send(wave), CommandResult::kDone);
+  Retired first;  // the stopped wave, handed back when the second replaced it
+  ASSERT_TRUE(b.loop->take_retired(first));
+  delete first.wave;  // NOLINT(cppcoreguidelines-owning-memory)
+  b.run(0.2 + 0.04);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed) << "faulted at the wave's end";
+  b.run(0.02);
+  EXPECT_NE(b.loop->supervisor().latched() & bit(Fault::kWatchdog), 0U);
+}
+
 }  // namespace
 }  // namespace selfsense::runtime

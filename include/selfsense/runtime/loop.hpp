@@ -42,7 +42,9 @@ struct LoopConfig {
   double stress_min{-1e8};  // [Pa]
   double stress_max{1e8};
   OverrunPolicy overrun{};
-  double watchdog_s{0.0};            // armed on socket setpoints: fault if none within it; 0: off
+  // Armed on socket setpoints: fault if none within it; 0: off. A wave feeds it while it plays;
+  // when the wave ends or is stopped the held setpoint has watchdog_s from then.
+  double watchdog_s{0.0};
   std::uint32_t status_period{100};  // cycles between status snapshots
   std::size_t command_capacity{64};
 
