@@ -174,7 +174,7 @@ double Loop::setpoint() noexcept {
   return hold_setpoint_;
 }
 
-void Loop::cycle(bool overrun) noexcept {
+void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
   ++cycle_;
   for (int i = 0; i < kCommandsPerCycle; ++i) {
     LoopCommand c;
@@ -219,7 +219,7 @@ void Loop::cycle(bool overrun) noexcept {
     sample.t_hat = est.stress;
     sample.s_hat = est.strain;
   }
-  supervisor_.note_cycle(overrun, cycle_);
+  supervisor_.note_cycle(overrun, cycle_, missed);
   if (config_.watchdog_s > 0.0 && supervisor_.armed() && !wave_running_ &&
       static_cast<double>(cycle_ - last_feed_) * config_.sample_time > config_.watchdog_s) {
     cause(Fault::kWatchdog);

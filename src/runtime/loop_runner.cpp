@@ -43,6 +43,7 @@ void LoopRunner::run() {
   std::int64_t late = 0;  // triggered cycles that started late
   while (!stop_.load(std::memory_order_relaxed)) {
     bool overrun = false;
+    std::int64_t missed = 0;
     if (trigger_ != nullptr) {
       overrun = !wait_trigger();
       if (overrun) ++late;
@@ -56,11 +57,12 @@ void LoopRunner::run() {
     } else {
       const Pacer::Tick tick = pacer.wait();
       overrun = tick.overrun;
+      missed = tick.missed;
       cycle = tick.cycle;
     }
     if (stall_.load(std::memory_order_relaxed)) continue;
     const std::int64_t begin = clock_->now_ns();
-    loop_->cycle(overrun);
+    loop_->cycle(overrun, missed);
     cycle_stats.record(clock_->now_ns() - begin);
     progress_.fetch_add(1, std::memory_order_relaxed);
     if (cycle % 1000 == 0) {

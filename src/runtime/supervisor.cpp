@@ -1,6 +1,8 @@
 #include "selfsense/runtime/supervisor.hpp"
 
+#include <algorithm>
 #include <array>
+#include <limits>
 
 namespace selfsense::runtime {
 
@@ -40,12 +42,15 @@ void Supervisor::report(Fault f, std::int64_t cycle) noexcept {
   state_ = LoopState::kFaulted;
 }
 
-void Supervisor::note_cycle(bool overrun, std::int64_t cycle) noexcept {
+void Supervisor::note_cycle(bool overrun, std::int64_t cycle, std::int64_t missed) noexcept {
   if (!overrun) {
     consecutive_ = 0;
     return;
   }
-  ++consecutive_;
+  const std::int64_t in_row =
+      static_cast<std::int64_t>(consecutive_) + 1 + std::max<std::int64_t>(missed, 0);
+  consecutive_ = static_cast<std::uint32_t>(
+      std::min<std::int64_t>(in_row, std::numeric_limits<std::uint32_t>::max()));
   recent_[recent_next_] = cycle;
   recent_next_ = (recent_next_ + 1) % recent_.size();
   // The within_count-th most recent overrun, still inside the window?

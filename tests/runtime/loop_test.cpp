@@ -333,6 +333,24 @@ TEST(Loop, OverrunPolicyAndWatchdogFault) {
   EXPECT_EQ(b.loop->local_status().last.command, 0.0);
 }
 
+// One stall is as long as many late cycles: a cycle late by k missed periods counts k + 1
+// overruns in a row (a 100 ms stall used to count as one; found by the soak test).
+TEST(Loop, AStallCountsEveryDeadlineItMissed) {
+  LoopConfig lc;
+  lc.overrun = {200, 64, 64};
+  Bench b(test::daemon_plant(kRate), bench_control(), lc);
+  start(b, ControlMode::kPosition);
+  b.loop->cycle(true, 150);  // 151 in a row
+  b.loop->cycle(false);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+  b.loop->cycle(true, 198);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+  b.loop->cycle(true);  // 200 in a row
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kFaulted);
+  EXPECT_NE(b.loop->supervisor().latched() & bit(Fault::kOverrun), 0U);
+  EXPECT_EQ(b.loop->local_status().last.command, 0.0);
+}
+
 // A wave that ended or was stopped after playing longer than the watchdog used to fault in the
 // next cycle (the watchdog counted from the wave's request); found by the soak test (tests/soak).
 TEST(Loop, TheWatchdogCountsTheHoldFromTheEndOfAWave) {

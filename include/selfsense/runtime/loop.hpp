@@ -76,8 +76,10 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
   Loop& operator=(Loop&&) = delete;
   ~Loop();
 
-  // One cycle. overrun: the pacer found this cycle's deadline already past.
-  void cycle(bool overrun) noexcept;
+  // One cycle. overrun: the pacer found this cycle's deadline already past; missed: the
+  // deadlines that passed without a cycle before it (a stall), which the overrun policy counts
+  // as overruns in a row.
+  void cycle(bool overrun, std::int64_t missed = 0) noexcept;
 
   // Control thread.
   bool submit(const LoopCommand& command) noexcept { return commands_.try_push(command); }

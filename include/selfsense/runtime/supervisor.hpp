@@ -10,7 +10,8 @@
 // reporting, before writing).
 //
 // Overrun policy: a fault after `consecutive` overruns in a row, or `within_count` overruns
-// within the last `window` cycles. Real-time safe: every method is noexcept, allocation-free.
+// within the last `window` cycles. A stall counts every deadline it missed: one late cycle after
+// k missed periods is k + 1 overruns in a row (the amplifier held its command that long). Real-time safe: every method is noexcept, allocation-free.
 #pragma once
 
 #include <array>
@@ -71,7 +72,8 @@ class Supervisor final {
   // A cause seen in this cycle: latches and moves to faulted.
   void report(Fault f, std::int64_t cycle) noexcept;
   // Overruns: feed every cycle whether it overran; trips kOverrun by the policy.
-  void note_cycle(bool overrun, std::int64_t cycle) noexcept;
+  // missed: deadlines that passed without a cycle before this late one (counted in a row).
+  void note_cycle(bool overrun, std::int64_t cycle, std::int64_t missed = 0) noexcept;
 
   // Requests; false (nothing changes) when not allowed in the current state.
   bool reset() noexcept;   // faulted -> ready (clears the latched faults)
