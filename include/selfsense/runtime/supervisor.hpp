@@ -11,7 +11,8 @@
 //
 // Overrun policy: a fault after `consecutive` overruns in a row, or `within_count` overruns
 // within the last `window` cycles. A stall counts every deadline it missed: one late cycle after
-// k missed periods is k + 1 overruns in a row (the amplifier held its command that long). Real-time safe: every method is noexcept, allocation-free.
+// k missed periods is k + 1 overruns in a row (the amplifier held its command that long).
+// Real-time safe: every method is noexcept, allocation-free.
 #pragma once
 
 #include <array>
