@@ -1,15 +1,10 @@
-// The real selfsensed as a child process for tests that crash, signal and reload it: a scratch
-// configuration derived from config/sim.yaml (the shipped example, so the test follows it), the
-// process started with its output in a log file, requests over its control socket, kill -9,
-// SIGHUP and SIGTERM.
+// The real selfsensed for tests that crash, signal and reload it: a scratch configuration
+// derived from config/sim.yaml (the shipped example, so the test follows it), and the process
+// (support/daemon_process.hpp) with requests over its control socket.
 #pragma once
 
-#include <fcntl.h>
 #include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <cerrno>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -22,6 +17,7 @@
 #include <vector>
 
 #include "selfsense/daemon/control_client.hpp"
+#include "support/daemon_process.hpp"
 
 namespace selfsense::daemon::testing {
 
@@ -65,41 +61,28 @@ inline std::string scratch_config(const std::filesystem::path& dir,
   return text;
 }
 
-class DaemonProcess final {
+// selfsensed started (test::DaemonProcess) and answering on its control socket.
+class RunningDaemon final {
  public:
-  // Starts selfsensed --config `config`; output to `log`. Waits until its socket answers.
-  DaemonProcess(const std::filesystem::path& config, std::filesystem::path socket,
-                std::filesystem::path log)
-      : socket_(std::move(socket)), log_(std::move(log)) {
-    pid_ = ::fork();
-    if (pid_ < 0) throw std::runtime_error("fork failed");
-    if (pid_ == 0) {
-      const int out = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-      if (out >= 0) {
-        ::dup2(out, STDOUT_FILENO);
-        ::dup2(out, STDERR_FILENO);
-      }
-      ::execl(SELFSENSED_BINARY, "selfsensed", "--config", config.c_str(),
-              static_cast<char*>(nullptr));
-      ::_exit(127);
-    }
+  // Starts selfsensed --config `config`; output to `log`.out and .err. Waits until its socket
+  // answers.
+  RunningDaemon(const std::filesystem::path& config, std::filesystem::path socket,
+                const std::filesystem::path& log)
+      : socket_(std::move(socket)),
+        err_(log.string() + ".err"),
+        process_(SELFSENSED_BINARY, config, log) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
     while (std::chrono::steady_clock::now() < deadline) {
-      if (exited()) throw std::runtime_error("selfsensed exited at start: " + read_text(log_));
+      if (process_.wait(std::chrono::milliseconds(0))) {
+        throw std::runtime_error("selfsensed exited at start: " + read_text(err_));
+      }
       try {
-        if (request(R"({"request": "status"})").value("ok", false)) return;
+        if (status().value("ok", false)) return;
       } catch (const ControlClientError&) {
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    throw std::runtime_error("selfsensed did not answer within 30 s: " + read_text(log_));
-  }
-  DaemonProcess(const DaemonProcess&) = delete;
-  DaemonProcess& operator=(const DaemonProcess&) = delete;
-  DaemonProcess(DaemonProcess&&) = delete;
-  DaemonProcess& operator=(DaemonProcess&&) = delete;
-  ~DaemonProcess() {
-    if (pid_ > 0) static_cast<void>(kill_hard());
+    throw std::runtime_error("selfsensed did not answer within 30 s: " + read_text(err_));
   }
 
   // One request line; the parsed reply. Throws ControlClientError when the socket fails.
@@ -109,40 +92,24 @@ class DaemonProcess final {
   }
   nlohmann::json status() { return request(R"({"request": "status"})"); }
 
-  void signal(int sig) const { ::kill(pid_, sig); }
-  // kill -9 and reap; returns the wait status.
+  void signal(int sig) const { process_.signal(sig); }
+  // kill -9; the exit status as test::DaemonProcess::wait gives it (128 + 9).
   int kill_hard() {
-    ::kill(pid_, SIGKILL);
-    return reap();
+    process_.signal(SIGKILL);
+    return process_.wait(std::chrono::seconds(10)).value_or(-1);
   }
-  // SIGTERM and the exit status (-1: did not exit normally).
+  // SIGTERM; the exit status (-1: none within 10 s).
   int terminate() {
-    ::kill(pid_, SIGTERM);
-    const int status = reap();
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    process_.signal(SIGTERM);
+    return process_.wait(std::chrono::seconds(10)).value_or(-1);
   }
-  [[nodiscard]] std::string log() const { return read_text(log_); }
+  // What it wrote to stderr so far.
+  [[nodiscard]] std::string log() const { return read_text(err_); }
 
  private:
-  bool exited() {
-    int status = 0;
-    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-      pid_ = -1;
-      return true;
-    }
-    return false;
-  }
-  int reap() {
-    int status = 0;
-    while (::waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
-    }
-    pid_ = -1;
-    return status;
-  }
-
   std::filesystem::path socket_;
-  std::filesystem::path log_;
-  pid_t pid_{-1};
+  std::filesystem::path err_;
+  test::DaemonProcess process_;
 };
 
 }  // namespace selfsense::daemon::testing

@@ -14,7 +14,7 @@
 namespace selfsense::daemon {
 namespace {
 
-using testing::DaemonProcess;
+using testing::RunningDaemon;
 
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
@@ -28,7 +28,7 @@ TEST(DaemonReload, OnlyAWholeValidFileIsTakenAndAModelOnlyWhileDisarmed) {
   testing::write_text(model_path, testing::read_text(source / "config" / "models" / "sim.yaml"));
   const std::string config_text = testing::scratch_config(dir.path(), {});
   testing::write_text(config, config_text);
-  DaemonProcess daemon(config, dir.path() / "control.sock", dir.path() / "selfsensed.log");
+  RunningDaemon daemon(config, dir.path() / "control.sock", dir.path() / "selfsensed.log");
   const auto reload = [&] { return daemon.request(R"({"request": "reload"})"); };
   const nlohmann::json start = daemon.status();
   const std::string hash0 = start["model"]["hash"];

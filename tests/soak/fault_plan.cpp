@@ -49,38 +49,6 @@ constexpr std::array<Item, 9> kRound{{
      0.001, 0.5, plant::kLateSample, Fault::kCount, false},
 }};
 
-const char* kind_name(FaultKind k) {
-  switch (k) {
-    case FaultKind::stuck_adc:
-      return "stuck_adc";
-    case FaultKind::nan_sample:
-      return "nan_sample";
-    case FaultKind::out_of_range:
-      return "out_of_range";
-    case FaultKind::missed_data_ready:
-      return "missed_data_ready";
-    case FaultKind::late_sample:
-      return "late_sample";
-    case FaultKind::amplifier_fault:
-      return "amplifier_fault";
-    case FaultKind::sensor_disconnect:
-      break;
-  }
-  return "sensor_disconnect";
-}
-
-const char* channel_name(Channel c) {
-  switch (c) {
-    case Channel::e:
-      return "e";
-    case Channel::d:
-      return "d";
-    case Channel::both:
-      break;
-  }
-  return "both";
-}
-
 }  // namespace
 
 std::vector<PlannedFault> make_plan(const PlanSettings& s) {
@@ -127,8 +95,8 @@ std::string plant_faults_yaml(const std::vector<PlannedFault>& plan, double rate
     static_cast<void>(std::snprintf(line.data(), line.size(),
                                     "    - {kind: %s, channel: %s, start_s: %.17g, "
                                     "duration_s: %.17g, late_by_s: %.17g}\n",
-                                    kind_name(f.kind), channel_name(f.channel), start_s, duration_s,
-                                    f.late_by_s));
+                                    plant::to_string(f.kind), plant::to_string(f.channel), start_s,
+                                    duration_s, f.late_by_s));
     text += line.data();
   }
   return text;

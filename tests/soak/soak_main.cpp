@@ -26,18 +26,19 @@
 #include <vector>
 
 #include "selfsense/daemon/control_client.hpp"
-#include "soak/daemon_process.hpp"
 #include "soak/fault_plan.hpp"
 #include "soak/recording_check.hpp"
 #include "soak/scratch_config.hpp"
 #include "soak/soak_figures.hpp"
 #include "soak/socket_abuse.hpp"
+#include "support/daemon_process.hpp"
 
 namespace selfsense::soak {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 using nlohmann::json;
+using test::DaemonProcess;
 
 constexpr double kKp = 2.0e8;  // config/sim.yaml's position gain; reloads alternate with 0.9 kp
 constexpr const char* kWave =

@@ -1,5 +1,6 @@
-// selfsensed as a child process of the soak test: started with its configuration, stdout and
-// stderr in files, signalled, its resident memory read from /proc, waited for.
+// selfsensed as a child process of a test (the soak test, the crash and reload tests): started
+// with its configuration, stdout and stderr in files, signalled, its resident memory read from
+// /proc, waited for.
 #pragma once
 
 #include <sys/types.h>
@@ -9,7 +10,7 @@
 #include <filesystem>
 #include <optional>
 
-namespace selfsense::soak {
+namespace selfsense::test {
 
 class DaemonProcess final {
  public:
@@ -27,6 +28,7 @@ class DaemonProcess final {
   // VmRSS [bytes]; nullopt once the process is gone.
   [[nodiscard]] std::optional<std::uint64_t> rss_bytes() const;
   // The exit status (or 128 + signal) once it exited within the timeout; nullopt otherwise.
+  // Once it returned a value, further calls give the same.
   std::optional<int> wait(std::chrono::milliseconds timeout);
   [[nodiscard]] bool running() const noexcept { return !exit_status_.has_value(); }
 
@@ -35,4 +37,4 @@ class DaemonProcess final {
   std::optional<int> exit_status_{};
 };
 
-}  // namespace selfsense::soak
+}  // namespace selfsense::test

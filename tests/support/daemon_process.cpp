@@ -1,4 +1,4 @@
-#include "soak/daemon_process.hpp"
+#include "support/daemon_process.hpp"
 
 #include <fcntl.h>
 #include <sys/wait.h>
@@ -10,7 +10,7 @@
 #include <string>
 #include <thread>
 
-namespace selfsense::soak {
+namespace selfsense::test {
 
 DaemonProcess::DaemonProcess(const std::filesystem::path& selfsensed,
                              const std::filesystem::path& config,
@@ -28,7 +28,7 @@ DaemonProcess::DaemonProcess(const std::filesystem::path& selfsensed,
         ::dup2(err_fd, STDERR_FILENO) < 0) {
       ::_exit(126);
     }
-    // The soak driver blocks nothing it passes on; the daemon sets its own mask.
+    // The test's signal mask is not the daemon's: it sets its own.
     sigset_t none;
     sigemptyset(&none);
     pthread_sigmask(SIG_SETMASK, &none, nullptr);
@@ -73,4 +73,4 @@ std::optional<int> DaemonProcess::wait(std::chrono::milliseconds timeout) {
   }
 }
 
-}  // namespace selfsense::soak
+}  // namespace selfsense::test
