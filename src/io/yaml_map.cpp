@@ -1,6 +1,9 @@
 #include "selfsense/io/yaml_map.hpp"
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
+#include <system_error>
 #include <utility>
 
 namespace selfsense::io {
@@ -115,20 +118,18 @@ YamlMap YamlMap::from_string(const std::string& text, const std::string& source)
 }
 
 YamlMap YamlMap::load_file(const std::filesystem::path& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path.string());
-  } catch (const YAML::BadFile&) {
-    raise(path.string() + ": cannot open the file");
-  } catch (const YAML::ParserException& e) {
-    raise(path.string() + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  // Only a regular file is read: yaml-cpp given a directory (an ifstream that opens but cannot be
+  // read) leaks its stream buffer, and "cannot open" is the clearer message anyway.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    raise(path.string() + (std::filesystem::exists(path, error) ? ": not a regular file"
+                                                                : ": cannot open the file"));
   }
-  if (!root.IsMap()) {
-    raise(path.string() + ":1: the document must be a mapping of keys to values");
-  }
-  auto context = std::make_shared<Context>();
-  context->source = path.string();
-  return YamlMap{root, "", context};
+  std::ifstream in{path, std::ios::binary};
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in || in.bad()) raise(path.string() + ": cannot read the file");
+  return from_string(text.str(), path.string());
 }
 
 std::string YamlMap::path(std::string_view key) const {

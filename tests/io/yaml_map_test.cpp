@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -120,6 +122,24 @@ TEST(YamlMap, ParseErrorsAndNonMappingDocuments) {
             "C.yaml:1: the document must be a mapping of keys to values");
   EXPECT_EQ(error_of([] { static_cast<void>(YamlMap::load_file("/nonexistent/x.yaml")); }),
             "/nonexistent/x.yaml: cannot open the file");
+}
+
+// Found by fuzzing (tests/fuzz/corpus/daemon_config/regression-plant-is-a-directory.yaml): a
+// path that names a directory reached yaml-cpp, which leaked its stream buffer; a file that
+// cannot be read is named as such.
+TEST(YamlMap, ADirectoryOrAnUnreadableFileIsNamed) {
+  const std::filesystem::path directory = std::filesystem::temp_directory_path();
+  EXPECT_EQ(error_of([&] { static_cast<void>(YamlMap::load_file(directory)); }),
+            directory.string() + ": not a regular file");
+  const std::filesystem::path file = directory / "selfsense-yaml-map-test.yaml";
+  {
+    std::ofstream out{file};
+    out << "a: 1\n";
+  }
+  YamlMap root = YamlMap::load_file(file);
+  EXPECT_EQ(root.required<int>("a"), 1);
+  EXPECT_EQ(root.locate("a: x"), file.string() + ":1: a: x");
+  std::filesystem::remove(file);
 }
 
 // Found by fuzzing (tests/fuzz/corpus/daemon_config/regression-*): a YAML escape, a quoted
