@@ -157,6 +157,7 @@ bool SpiDriver::initialise_adc(std::string* why) noexcept {
   transfer_run_ = 0;
   no_data_run_ = 0;
   stuck_run_ = 0;
+  have_codes_ = false;
   return true;
 }
 
@@ -287,11 +288,13 @@ runtime::DriverStatus SpiDriver::read(runtime::InputSample& out) noexcept {
   } else {
     no_data_run_ = 0;
   }
-  if (e_code == last_e_code_ && d_code == last_d_code_) {
+  // Unchanged from the previous frame of this (re-)initialisation: the first has none.
+  if (have_codes_ && e_code == last_e_code_ && d_code == last_d_code_) {
     ++stuck_run_;
   } else {
     stuck_run_ = 0;
   }
+  have_codes_ = true;
   last_e_code_ = e_code;
   last_d_code_ = d_code;
   const auto clipped = [](std::int32_t c) { return c >= adc::kCodeMax || c <= adc::kCodeMin; };

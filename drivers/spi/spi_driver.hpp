@@ -179,6 +179,7 @@ class SpiDriver final : public runtime::Driver, private runtime::CycleTrigger {
   int transfer_run_{0};
   int no_data_run_{0};
   int stuck_run_{0};
+  bool have_codes_{false};  // last_*_code_ hold a frame of this (re-)initialisation
   std::int32_t last_e_code_{0};
   std::int32_t last_d_code_{0};
   std::int64_t read_ns_{0};

@@ -213,6 +213,30 @@ TEST(SpiDriver, AStuckConverterIsStaleAfterStuckFrames) {
   EXPECT_EQ(f.cycle(1e6), DriverStatus::kOk);
 }
 
+// Found by fuzz_spi_frame (corpus/spi_frame/regression-stuck-*): the first frame after
+// activation was compared with codes never read (0, 0), the first after a re-initialisation
+// with the codes before it, so a converter at 0 was stuck one frame early (with stuck_frames 1:
+// the first read of the loop stale).
+TEST(SpiDriver, TheStuckCountStartsAtTheFirstFrameOfEachInitialisation) {
+  drivers::spi::SpiConfig c = emulated_spi_config(kRate);
+  c.faults.stuck_frames = 2;
+  Fixture f(c);
+  f.bench->adc.set_stuck(true);  // frozen at 0 from power-up: every code 0, inside the ranges
+  ASSERT_TRUE(f.start());
+  EXPECT_EQ(f.cycle(), DriverStatus::kOk);  // the first frame: nothing to repeat
+  EXPECT_EQ(f.cycle(), DriverStatus::kOk);  // one repeat
+  EXPECT_EQ(f.cycle(), DriverStatus::kStale);
+  EXPECT_EQ(f.bench->driver.spi_counters().stuck, 1U);
+  f.bench->adc.spontaneous_reset();
+  EXPECT_EQ(f.cycle(), DriverStatus::kDeviceFault);
+  f.bench->driver.service(0);
+  ASSERT_EQ(f.bench->driver.adc_state(), drivers::spi::AdcState::kRunning);
+  EXPECT_EQ(f.cycle(), DriverStatus::kOk);  // the first frame of the re-initialised ADC
+  EXPECT_EQ(f.cycle(), DriverStatus::kOk);
+  EXPECT_EQ(f.cycle(), DriverStatus::kStale);
+  EXPECT_EQ(f.bench->driver.spi_counters().stuck, 2U);
+}
+
 TEST(SpiDriver, FramesWithoutANewConversionAreStaleBeyondTheAllowance) {
   Fixture f;  // stale_frames 2
   ASSERT_TRUE(f.start());
