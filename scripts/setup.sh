@@ -26,6 +26,7 @@ packages=(
   clang libclang-rt-14-dev  # the sanitizer build and the fuzz targets (libFuzzer), tests/fuzz
   zlib1g-dev chromium fonts-liberation  # the diagnosis report's browser test (tests/cli)
   mbpoll
+  rt-tests  # cyclictest beside the loop in tests/bench/loop_timing_bench (docs/benchmarks.md)
 )
 
 install_missing() {

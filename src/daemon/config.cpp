@@ -194,6 +194,10 @@ void validate(const DaemonConfig& c, Problems& p) {
   p.check(c.loop.priority >= 1 && c.loop.priority <= 99, "loop.priority",
           std::to_string(c.loop.priority) + " must be within [1, 99] (SCHED_FIFO)");
   p.check(c.loop.cpu >= -1, "loop.cpu", "must be -1 (any) or a CPU index");
+  p.check(c.loop.cpu_dma_latency_us >= -1 && c.loop.cpu_dma_latency_us <= 1000000,
+          "loop.cpu_dma_latency_us",
+          std::to_string(c.loop.cpu_dma_latency_us) +
+              " must be -1 (no request) or within [0, 1000000]");
   p.check(c.loop.status_period_cycles >= 1, "loop.status_period_cycles", "must be >= 1");
   if (!(fs > 0.0)) return;
   const double ts = 1.0 / fs;
@@ -301,6 +305,7 @@ ConfigResult load_config(const std::filesystem::path& path, DriverSectionReader*
       l->read("rate_hz", c.loop.rate_hz);
       l->read("priority", c.loop.priority);
       l->read("cpu", c.loop.cpu);
+      l->read("cpu_dma_latency_us", c.loop.cpu_dma_latency_us);
       l->read("allow_degraded_timing", c.loop.allow_degraded_timing);
       read_u32(*l, "status_period_cycles", c.loop.status_period_cycles);
       l->finish();

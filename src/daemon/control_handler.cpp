@@ -119,6 +119,9 @@ nlohmann::json ControlHandler::status() {
   nlohmann::json rt_problems = nlohmann::json::array();
   for (const std::string& p : daemon_->rt_setup().problems)
     rt_problems.push_back(p);
+  nlohmann::json rt_notes = nlohmann::json::array();
+  for (const std::string& n : daemon_->rt_setup().notes)
+    rt_notes.push_back(n);
   return ok_reply({
       {"state", runtime::to_string(s.state)},
       {"mode", std::string(mode_name(s.mode))},
@@ -140,7 +143,8 @@ nlohmann::json ControlHandler::status() {
           {"p99", s.cycle_time_p99_ns},
           {"max", s.cycle_time_max_ns}}},
         {"degraded", daemon_->degraded_timing()},
-        {"realtime_problems", rt_problems}}},
+        {"realtime_problems", rt_problems},
+        {"realtime_notes", rt_notes}}},
       {"recording", {{"path", path ? nlohmann::json(path->string()) : nlohmann::json(nullptr)}}},
       {"estimate",
        {{"E", number_or_null(s.last.e)},

@@ -50,6 +50,14 @@ RecorderConfig recorder_config(const DaemonConfig& c, bool references) {
   return r;
 }
 
+runtime::RtOptions rt_options(const LoopSection& loop) {
+  runtime::RtOptions o;
+  o.priority = loop.priority;
+  o.cpu = loop.cpu;
+  o.cpu_latency_us = loop.cpu_dma_latency_us;
+  return o;
+}
+
 std::string fault_name(unsigned bit) {
   return std::string(runtime::to_string(static_cast<runtime::Fault>(bit)));
 }
@@ -78,8 +86,7 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
   loop_ = std::make_unique<runtime::Loop>(config_.loop_config(), *driver_,
                                           std::move(reconstruction), controller, sink_.get());
   runner_ = std::make_unique<runtime::LoopRunner>(
-      *loop_, clock_, std::llround(ts * 1e9),
-      runtime::RtOptions{config_.loop.priority, config_.loop.cpu}, driver_->cycle_trigger());
+      *loop_, clock_, std::llround(ts * 1e9), rt_options(config_.loop), driver_->cycle_trigger());
 }
 
 Daemon::~Daemon() {
@@ -304,6 +311,9 @@ int Daemon::run() {
     static_cast<void>(std::fprintf(
         stderr, "selfsensed: real-time set-up: %s%s\n", p.c_str(),
         config_.loop.allow_degraded_timing ? " (degraded timing allowed)" : " (arming refused)"));
+  }
+  for (const std::string& n : rt_setup_.notes) {
+    static_cast<void>(std::fprintf(stderr, "selfsensed: real-time set-up: %s (note)\n", n.c_str()));
   }
   ControlServerConfig server_config;
   server_config.path = config_.socket.path;

@@ -1,5 +1,7 @@
 #include "selfsense/runtime/loop_runner.hpp"
 
+#include <string>
+
 #include "selfsense/runtime/cycle_stats.hpp"
 #include "selfsense/runtime/latency_histogram.hpp"
 
@@ -28,6 +30,14 @@ void LoopRunner::stop() {
 
 void LoopRunner::run() {
   RtSetupResult setup = setup_realtime(rt_);
+  // Held until the thread ends, dropped when it returns.
+  CpuLatencyRequest latency;
+  if (rt_.cpu_latency_us >= 0) {
+    std::string why;
+    latency = CpuLatencyRequest(rt_.cpu_latency_us, &why);
+    setup.cpu_latency_held = latency.held();
+    if (!latency.held()) setup.notes.push_back(why);
+  }
   Pacer pacer(*clock_, period_ns_);
   CycleStats cycle_stats(period_ns_);
   LatencyHistogram trigger_wake;  // paced by the trigger: its time stamp to the wake-up

@@ -1,12 +1,15 @@
 #include "selfsense/runtime/rt_setup.hpp"
 
+#include <fcntl.h>
 #include <malloc.h>
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <cerrno>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -29,6 +32,40 @@ void prefault_stack(std::size_t bytes) {
 }
 
 }  // namespace
+
+CpuLatencyRequest::CpuLatencyRequest(int us, std::string* why) {
+  const char* const path = "/dev/cpu_dma_latency";
+  const int fd = ::open(path, O_WRONLY | O_CLOEXEC);
+  const std::int32_t value = us;  // the kernel takes a binary 32-bit value
+  if (fd >= 0 && ::write(fd, &value, sizeof(value)) == static_cast<ssize_t>(sizeof(value))) {
+    fd_ = fd;
+    return;
+  }
+  const int e = errno;
+  if (fd >= 0) ::close(fd);
+  if (why != nullptr) {
+    *why = std::string("CPU wake-up latency ") + std::to_string(us) + " us (" + path +
+           "): " + std::strerror(e) +
+           " (written by root only unless a udev rule grants it; deep idle states stay allowed)";
+  }
+}
+
+CpuLatencyRequest::CpuLatencyRequest(CpuLatencyRequest&& other) noexcept : fd_(other.fd_) {
+  other.fd_ = -1;
+}
+
+CpuLatencyRequest& CpuLatencyRequest::operator=(CpuLatencyRequest&& other) noexcept {
+  if (this != &other) {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = other.fd_;
+    other.fd_ = -1;
+  }
+  return *this;
+}
+
+CpuLatencyRequest::~CpuLatencyRequest() {
+  if (fd_ >= 0) ::close(fd_);  // closing the file drops the request
+}
 
 RtSetupResult setup_realtime(const RtOptions& options) {
   RtSetupResult r;

@@ -67,6 +67,20 @@ TEST(DaemonConfig, UnknownKeysAreNamedWithTheirLine) {
   EXPECT_TRUE(has(r, "loop.prio")) << r.problems.front();
 }
 
+TEST(DaemonConfig, TheCpuLatencyRequestIsReadAndBounded) {
+  const ConfigResult shipped = load(write("latency", sim_with("rate_hz: 10000", "rate_hz: 10000")));
+  ASSERT_TRUE(shipped.ok()) << shipped.problems.front();
+  EXPECT_EQ(shipped.config.loop.cpu_dma_latency_us, 0);
+  const ConfigResult none =
+      load(write("latency", sim_with("cpu_dma_latency_us: 0", "cpu_dma_latency_us: -1")));
+  ASSERT_TRUE(none.ok()) << none.problems.front();
+  EXPECT_EQ(none.config.loop.cpu_dma_latency_us, -1);
+  const ConfigResult bad =
+      load(write("latency", sim_with("cpu_dma_latency_us: 0", "cpu_dma_latency_us: -5")));
+  EXPECT_TRUE(has(bad, ".test-latency.yaml:9: loop.cpu_dma_latency_us: -5 must be -1"))
+      << (bad.problems.empty() ? "" : bad.problems.front());
+}
+
 TEST(DaemonConfig, EveryValueProblemIsReportedAtOnce) {
   std::string text = sim_with("rate_hz: 10000", "rate_hz: 3000");  // notch 2 kHz > 0.45 fs
   const std::size_t at = text.find("priority: 80");

@@ -74,8 +74,9 @@ std::string daemon_config_text(const std::filesystem::path& source_dir, const Sc
 
 Scratch write_scratch(const std::filesystem::path& source_dir,
                       const std::filesystem::path& directory, const std::string& faults_yaml,
-                      double kp) {
+                      double kp, double rate_hz) {
   Scratch s;
+  s.rate_hz = rate_hz;
   s.directory = directory;
   s.config = directory / "soak.yaml";
   s.plant = directory / "plant.yaml";

@@ -24,11 +24,11 @@ struct Scratch {
 };
 
 // Writes the plant file (config/plant/daemon.yaml with `faults_yaml` inside its plant section)
-// and the daemon configuration with position gain kp. Throws std::runtime_error naming a key
-// the shipped files no longer have.
+// and the daemon configuration with position gain kp and loop rate rate_hz. Throws
+// std::runtime_error naming a key the shipped files no longer have.
 [[nodiscard]] Scratch write_scratch(const std::filesystem::path& source_dir,
                                     const std::filesystem::path& directory,
-                                    const std::string& faults_yaml, double kp);
+                                    const std::string& faults_yaml, double kp, double rate_hz);
 
 // Writes the daemon configuration again with another kp (a valid reload), atomically: written
 // beside and renamed over, so a reload never reads half a file.

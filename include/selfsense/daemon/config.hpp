@@ -51,8 +51,9 @@ inline constexpr int kConfigFormatVersion = 1;
 
 struct LoopSection {
   double rate_hz{10000.0};
-  int priority{80};  // SCHED_FIFO 1..99
-  int cpu{-1};       // affinity; -1: any
+  int priority{80};           // SCHED_FIFO 1..99
+  int cpu{-1};                // affinity; -1: any
+  int cpu_dma_latency_us{0};  // CPU wake-up latency requested while running; -1: none
   bool allow_degraded_timing{false};
   std::uint32_t status_period_cycles{100};
   friend bool operator==(const LoopSection&, const LoopSection&) = default;
