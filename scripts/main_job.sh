@@ -1,9 +1,15 @@
 #!/usr/bin/env bash
 # The README's main job: selfsensed on config/sim.yaml (the simulated transducer, paced in real
-# time), armed through `selfsense ctl`: a position staircase and sine, a force step, a damping
-# run; for each, the tracking error of S_hat (or T_hat) and of the plant's true S (or T) against
-# the setpoint, from the daemon's own recording; an HTML page with the plots; a clean stop.
+# time), armed through `selfsense ctl`: a position staircase and sine, a force step; then
+# selfsensed on config/damping-sim.yaml (the same stack on a 300 Hz mount) for a damping run: a
+# force impulse from the bench (`ctl impulse`) in open loop and again with positive position
+# feedback on S_hat. For each, from the daemon's own recording, the tracking error of S_hat (or
+# T_hat) and of the plant's true S (or T) against the setpoint, or the ring-down times; an HTML
+# page with the plots; a clean stop of each daemon.
 #   scripts/main_job.sh BUILD_DIR OUT_DIR
+# SELFSENSE_MAIN_JOB_CONFIG: another configuration of config/ for the first part (e.g.
+# config/modbus-sim.yaml through scripts/modbus_main_job.sh), which then skips the damping run
+# (it needs the simulated transducer's force input).
 set -euo pipefail
 build=${1:?usage: scripts/main_job.sh BUILD_DIR OUT_DIR}
 out=${2:?usage: scripts/main_job.sh BUILD_DIR OUT_DIR}
@@ -13,29 +19,42 @@ daemon=$build/src/selfsensed/selfsensed
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 
-# The shipped configuration with this run's paths (SELFSENSE_MAIN_JOB_CONFIG: another one of
-# config/, e.g. config/modbus-sim.yaml through scripts/modbus_main_job.sh).
+# start_daemon SHIPPED_CONFIG: the configuration with this run's paths (beside the shipped one,
+# so its relative paths resolve), checked, and selfsensed started on it; waits for its socket.
 config=$root/config/.main-job.yaml
-sed -e "s|directory: ../build/[a-z-]*/recordings|directory: $out/recordings|" \
-  -e "s|path: ../build/[a-z-]*/control.sock|path: $out/control.sock|" \
-  -e "s|prometheus_file: ../build/[a-z-]*/selfsensed.prom|prometheus_file: $out/selfsensed.prom|" \
-  "${SELFSENSE_MAIN_JOB_CONFIG:-$root/config/sim.yaml}" >"$config"
-"$cli" check-config "$config"
-
-"$daemon" --config "$config" >"$out/daemon.log" 2>&1 &
-pid=$!
+pid=
+start_daemon() {
+  sed -e "s|directory: ../build/[a-z-]*/recordings|directory: $out/recordings|" \
+    -e "s|path: ../build/[a-z-]*/control.sock|path: $out/control.sock|" \
+    -e "s|prometheus_file: ../build/[a-z-]*/selfsensed.prom|prometheus_file: $out/selfsensed.prom|" \
+    "$1" >"$config"
+  "$cli" check-config "$config"
+  rm -f "$out/control.sock"  # the previous daemon's
+  "$daemon" --config "$config" >>"$out/daemon.log" 2>&1 &
+  pid=$!
+  for _ in $(seq 100); do
+    [ -S "$out/control.sock" ] && break
+    sleep 0.1
+  done
+}
+# stop_daemon: SIGTERM, its exit status printed (the end-to-end test checks it).
+stop_daemon() {
+  kill -TERM "$pid"
+  local status=0
+  wait "$pid" || status=$?
+  pid=
+  rm -f "$config"
+  echo "selfsensed exited with status $status"
+}
 cleanup() {
-  kill -TERM "$pid" 2>/dev/null || true
-  wait "$pid" 2>/dev/null || true
+  [ -n "$pid" ] && kill -TERM "$pid" 2>/dev/null && wait "$pid" 2>/dev/null
   rm -f "$config"
 }
 trap cleanup EXIT
-for _ in $(seq 100); do
-  [ -S "$out/control.sock" ] && break
-  sleep 0.1
-done
 ctl() { "$cli" ctl --socket "$out/control.sock" "$@"; }
 value() { sed -n "s/.*\"$1\":\([^,}]*\).*/\1/p"; }
+
+start_daemon "${SELFSENSE_MAIN_JOB_CONFIG:-$root/config/sim.yaml}"
 
 # segment NAME MODE: one recording per segment.
 segment_start() {
@@ -71,10 +90,29 @@ done
 segment_stop force
 
 ctl status --pretty >"$out/status.json"
-kill -TERM "$pid"
-wait "$pid"
-status=$?
+stop_daemon
+segments=(position force)
+
+if [ -z "${SELFSENSE_MAIN_JOB_CONFIG:-}" ]; then
+  echo "== damping: a 300 N impulse of 0.5 ms on a 300 Hz mount, in open loop, then with PPF on S_hat"
+  start_daemon "$root/config/damping-sim.yaml"
+  for run in open-loop:undamped damping:damped; do
+    # Recorded from rest: armed, settled on the setpoint, then the impulse.
+    ctl disarm >/dev/null 2>&1 || true
+    ctl mode "${run%%:*}" >/dev/null
+    ctl reset >/dev/null 2>&1 || true
+    sleep 0.3
+    ctl arm >/dev/null
+    ctl setpoint 6.0e-4 >/dev/null
+    sleep 0.6
+    ctl record start | value path | tr -d '"' >"$out/${run#*:}.path"
+    sleep 0.1
+    ctl impulse 300 --duration 5e-4 >/dev/null
+    sleep 0.6
+    segment_stop "${run#*:}"
+  done
+  stop_daemon
+  segments+=(undamped damped)
+fi
 trap - EXIT
-rm -f "$config"
-echo "selfsensed exited with status $status"
-"$root/scripts/main_job_report.sh" "$out" position force
+"$root/scripts/main_job_report.sh" "$out" "${segments[@]}"

@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# Figures and plots of the main job's recordings (scripts/main_job.sh): for each segment the RMS
-# error of the self-sensed signal and of the plant's true one against the setpoint, in % of the
-# setpoint's range, over the settled samples (0.2 s after each setpoint step on), and an HTML
-# page with an inline SVG plot per segment.
+# Figures and plots of the main job's recordings (scripts/main_job.sh): for each tracking segment
+# the RMS error of the self-sensed signal and of the plant's true one against the setpoint, in %
+# of the setpoint's range, over the settled samples (0.2 s after each setpoint step on); for the
+# damping run's segments (undamped, damped) the ring-down after the impulse: the time from the
+# largest deviation of true S (and of S_hat) from its rest to the last sample outside 5 % of that
+# deviation, the rest being the mean of the recording's last 40 %. An HTML page with an inline
+# SVG plot per segment.
 #   scripts/main_job_report.sh OUT_DIR SEGMENT...   (SEGMENT.path holds its recording's path)
 set -euo pipefail
 out=${1:?usage: scripts/main_job_report.sh OUT_DIR SEGMENT...}
@@ -13,8 +16,53 @@ html=$out/main_job.html
   echo '<style>body{font-family:sans-serif;margin:2em}svg{border:1px solid #ccc}</style></head><body>'
   echo '<h1>selfsensed on the simulated transducer</h1>'
 } >"$html"
+# ring_down SEGMENT FILE: figures line on stdout, the plot (S - rest over 0.4 s from 0.05 s before
+# the peak, true S red, S_hat blue) in OUT/SEGMENT.svg.
+ring_down() {
+  awk -F, -v seg="$1" -v svg="$out/$1.svg" '
+    /^#/ { next }
+    !header { for (i = 1; i <= NF; i++) col[$i] = i; header = 1; next }
+    { n++; t[n] = $col["t"]; x[n] = $col["S"]; h[n] = $col["S_hat"] }
+    function rest(v,   i, m, s) { for (i = int(0.6 * n); i <= n; i++) { s += v[i]; m++ } return s / m }
+    function ring(v, base,   i, d, peak, at, last) {
+      peak = 0; at = 1
+      for (i = 1; i <= n; i++) { d = v[i] - base; if (d < 0) d = -d; if (d > peak) { peak = d; at = i } }
+      last = at
+      for (i = at; i <= n; i++) { d = v[i] - base; if (d < 0) d = -d; if (d > 0.05 * peak) last = i }
+      PEAK = peak; AT = at
+      return t[last] - t[at]
+    }
+    END {
+      bx = rest(x); bh = rest(h)
+      rh = ring(h, bh); rx = ring(x, bx); peak = PEAK; at = AT
+      printf "%s: %d samples, peak deviation of true S %.3g, ring-down to 5 %%: true S %.1f ms, S_hat %.1f ms\n",
+             seg, n, peak, 1000 * rx, 1000 * rh
+      W = 900; H = 300; t0 = t[at] - 0.05; t1 = t0 + 0.4
+      printf "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\">\n", W, H > svg
+      for (k = 1; k <= 2; k++) {
+        printf "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1\" points=\"", (k == 1) ? "#d62728" : "#1f77b4" > svg
+        for (i = 1; i <= n; i++) {
+          if (t[i] < t0 || t[i] > t1) continue
+          v = (k == 1) ? x[i] - bx : h[i] - bh
+          printf "%.1f,%.1f ", W * (t[i] - t0) / (t1 - t0), H * (0.5 - 0.45 * v / peak) > svg
+        }
+        print "\"/>" > svg
+      }
+      print "</svg>" > svg
+    }' "$2"
+}
+
 for segment in "$@"; do
   file=$(cat "$out/$segment.path")
+  if [ "$segment" = undamped ] || [ "$segment" = damped ]; then
+    ring_down "$segment" "$file" | tee -a "$out/figures.txt"
+    {
+      echo "<h2>damping run: $segment</h2><p>$(tail -1 "$out/figures.txt")</p>"
+      echo "<p>S minus its rest after a 300 N impulse of 0.5 ms, 0.4 s from 0.05 s before the peak; red: true S, blue: S_hat (the signal the loop damps)</p>"
+      cat "$out/$segment.svg"
+    } >>"$html"
+    continue
+  fi
   # position: S_hat and S; force: T_hat and T.
   if [ "$segment" = force ]; then hat=T_hat truth=T unit=Pa; else hat=S_hat truth=S unit=-; fi
   awk -F, -v hat="$hat" -v truth="$truth" -v seg="$segment" -v unit="$unit" -v svg="$out/$segment.svg" '
@@ -53,5 +101,12 @@ for segment in "$@"; do
     cat "$out/$segment.svg"
   } >>"$html"
 done
+if grep -q '^undamped: ' "$out/figures.txt" && grep -q '^damped: ' "$out/figures.txt"; then
+  ms() { sed -n "s/^$1: .* true S \([0-9.]*\) ms, S_hat \([0-9.]*\) ms/\\$2/p" "$out/figures.txt"; }
+  awk -v ux="$(ms undamped 1)" -v dx="$(ms damped 1)" -v uh="$(ms undamped 2)" -v dh="$(ms damped 2)" \
+    'BEGIN { printf "damping: ring-down shortened %.1fx on true S, %.1fx on S_hat (goal 10x)\n", ux / dx, uh / dh }' |
+    tee -a "$out/figures.txt"
+  echo "<p><b>$(tail -1 "$out/figures.txt")</b></p>" >>"$html"
+fi
 echo '</body></html>' >>"$html"
 echo "wrote $html"

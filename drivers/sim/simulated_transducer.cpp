@@ -45,7 +45,12 @@ bool SimulatedTransducer::activate(std::string* why) {
 runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexcept {
   if (!active_) return runtime::DriverStatus::kNotActive;
   ++counters_.reads;
-  const plant::StepInput input{command_, force_n_.load(std::memory_order_relaxed), 25.0};
+  // A pulse from apply() lasts while this cycle is before its end (cycle_published_ is the
+  // count of cycles read so far: the pulse starts with the next read after apply()).
+  const bool pulse = cycles_ < pulse_end_cycle_.load(std::memory_order_acquire);
+  const double force = force_n_.load(std::memory_order_relaxed) +
+                       (pulse ? pulse_n_.load(std::memory_order_relaxed) : 0.0);
+  const plant::StepInput input{command_, force, 25.0};
   plant::StepOutput o{};
   // The plant may run several steps per loop cycle; a fault flag raised in any of them is the
   // device's (like the sticky bits of a status register), not only one in the step read last.
@@ -57,6 +62,7 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
     latency_s = std::max(latency_s, o.latency_s);
   }
   ++cycles_;
+  cycle_published_.store(cycles_, std::memory_order_relaxed);
   out.e = o.e_meas_v_per_m;
   out.d = o.d_meas_c_per_m2;
   out.s_ref = o.s;
@@ -121,6 +127,14 @@ bool SimulatedTransducer::inject(plant::FaultKind kind, plant::Channel channel,
   if (!plant_) return false;
   const std::int64_t now = plant_->save().sample;
   return plant_->inject(kind, channel, now + after_cycles * substeps_, cycles * substeps_);
+}
+
+void SimulatedTransducer::apply(double newtons, double seconds) noexcept {
+  const auto cycles = std::max<std::int64_t>(1, std::llround(seconds / sample_time_));
+  // Force first, then the end that makes it visible (release; the loop's read acquires).
+  pulse_n_.store(newtons, std::memory_order_relaxed);
+  pulse_end_cycle_.store(cycle_published_.load(std::memory_order_relaxed) + cycles,
+                         std::memory_order_release);
 }
 
 }  // namespace selfsense::drivers

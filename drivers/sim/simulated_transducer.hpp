@@ -32,7 +32,7 @@
 
 namespace selfsense::drivers {
 
-class SimulatedTransducer final : public runtime::Driver {
+class SimulatedTransducer final : public runtime::Driver, public runtime::ForceInput {
  public:
   explicit SimulatedTransducer(plant::PlantConfig config);
 
@@ -44,6 +44,9 @@ class SimulatedTransducer final : public runtime::Driver {
   void deactivate() noexcept override;
   [[nodiscard]] bool has_references() const noexcept override { return true; }
   [[nodiscard]] runtime::DriverCounters counters() const noexcept override;
+  [[nodiscard]] runtime::ForceInput* force_input() noexcept override { return this; }
+  // A force pulse on the stack (ForceInput), on top of set_external_force(); any thread.
+  void apply(double newtons, double seconds) noexcept override;
 
   // Test bench: an external force [N] on the stack (a load step, an impulse), any thread.
   void set_external_force(double newtons) noexcept {
@@ -66,6 +69,10 @@ class SimulatedTransducer final : public runtime::Driver {
   double command_{0.0};
   std::int64_t cycles_{0};
   std::atomic<double> force_n_{0.0};
+  // The pulse: its force, and the loop cycle it ends before (cycles_ as published for it).
+  std::atomic<double> pulse_n_{0.0};
+  std::atomic<std::int64_t> pulse_end_cycle_{0};
+  std::atomic<std::int64_t> cycle_published_{0};
   runtime::DriverCounters counters_{};
   // Cycles in which each plant fault flag was raised (counters() events *_cycles).
   struct Causes {

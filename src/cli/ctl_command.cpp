@@ -191,6 +191,17 @@ void add_ctl_command(CLI::App& app) {
     send_request(*options, daemon::to_json(RecordRequest{kind}));
   });
 
+  auto force = std::make_shared<double>(0.0);
+  auto duration = std::make_shared<double>(5e-4);
+  CLI::App* impulse = ctl->add_subcommand(
+      "impulse", "Push the stack with a force pulse from the bench (the simulated transducer)");
+  impulse->fallthrough();
+  impulse->add_option("force_n", *force, "The pulse's force [N]")->required();
+  impulse->add_option("--duration", *duration, "The pulse's length [s]")->capture_default_str();
+  impulse->callback([options, force, duration] {
+    send_request(*options, daemon::to_json(daemon::ImpulseRequest{*force, *duration}));
+  });
+
   add_wave(*ctl, options);
 }
 

@@ -206,6 +206,15 @@ nlohmann::json ControlHandler::handle(const Request& request, const PeerCredenti
       return error_reply(std::string("record: ") + e.what());
     }
   }
+  if (const auto* i = std::get_if<ImpulseRequest>(&request)) {
+    runtime::ForceInput* input = daemon_->force_input();
+    if (input == nullptr) {
+      return error_reply("impulse: the driver (" + std::string(daemon_->driver().name()) +
+                         ") has no force input; the simulated transducer has one");
+    }
+    input->apply(i->force_n, i->duration_s);
+    return ok_reply({{"force_n", i->force_n}, {"duration_s", i->duration_s}});
+  }
   if (std::holds_alternative<ReloadRequest>(request)) {
     const ReloadResult reloaded = daemon_->reload();
     if (reloaded.ok()) {

@@ -16,8 +16,8 @@ namespace {
 using nlohmann::json;
 using Shape = control::WaveGenerator::Shape;
 
-constexpr std::array<std::string_view, 9> kRequestNames = {
-    "status", "arm", "disarm", "reset", "setpoint", "mode", "wave", "record", "reload"};
+constexpr std::array<std::string_view, 10> kRequestNames = {
+    "status", "arm", "disarm", "reset", "setpoint", "mode", "wave", "record", "reload", "impulse"};
 constexpr std::array<std::string_view, RequestLimits::kModes> kModeNames = {"position", "force",
                                                                             "open-loop", "damping"};
 // Echoed user strings are cut so an error reply stays short whatever was sent.
@@ -208,6 +208,16 @@ RecordRequest parse_record(const json& object) {
   reject(m.path("action") + ": " + echo(action) + " is not an action (start, stop)");
 }
 
+ImpulseRequest parse_impulse(const json& object, const RequestLimits& limits) {
+  const Members m(object, "impulse", {"force_n", "duration_s"}, "impulse");
+  const double force = m.number("force_n");
+  const double duration = m.number("duration_s");
+  check_in(m.path("force_n"), force, -limits.max_impulse_n, limits.max_impulse_n, " N");
+  check_in(m.path("duration_s"), duration, limits.sample_time, limits.max_impulse_s,
+           " s (one loop period at least)");
+  return ImpulseRequest{force, duration};
+}
+
 std::optional<Shape> shape_from_name(std::string_view name) {
   if (name == "sine") return Shape::kSine;
   if (name == "triangle") return Shape::kTriangle;
@@ -367,6 +377,7 @@ Request parse_object(const json& object, const RequestLimits& limits) {
   if (kind == "mode") return parse_mode(object);
   if (kind == "wave") return parse_wave(object, limits);
   if (kind == "record") return parse_record(object);
+  if (kind == "impulse") return parse_impulse(object, limits);
   reject("request: " + echo(kind) + " is not a request (" + joined(kRequestNames) + ")");
 }
 
@@ -420,6 +431,10 @@ bool RequestLimits::is_valid(std::string* why) const {
   if (max_levels < 1) return fail("max_levels >= 1");
   if (max_table_values < 2) return fail("max_table_values >= 2");
   if (!(max_dwell_s > 0.0) || !std::isfinite(max_dwell_s)) return fail("max_dwell_s > 0");
+  if (!(max_impulse_n > 0.0) || !std::isfinite(max_impulse_n)) return fail("max_impulse_n > 0");
+  if (!(max_impulse_s >= sample_time) || !std::isfinite(max_impulse_s)) {
+    return fail("max_impulse_s >= sample_time");
+  }
   for (std::size_t i = 0; i < kModes; ++i) {
     const auto& range = setpoint.at(i);
     if (range &&
@@ -494,6 +509,10 @@ nlohmann::json to_json(const Request& request) {
     out["name"] = std::string(mode_name(mode->mode));
   if (const auto* record = std::get_if<RecordRequest>(&request)) {
     out["action"] = record->action == RecordRequest::Action::kStart ? "start" : "stop";
+  }
+  if (const auto* impulse = std::get_if<ImpulseRequest>(&request)) {
+    out["force_n"] = impulse->force_n;
+    out["duration_s"] = impulse->duration_s;
   }
   if (const auto* wave_request = std::get_if<WaveRequest>(&request)) {
     if (wave_request->stop) {

@@ -107,6 +107,19 @@ TEST(ControlProtocol, Record) {
   EXPECT_EQ(rejected(R"({"request":"record"})"), "record.action: missing");
 }
 
+TEST(ControlProtocol, Impulse) {
+  EXPECT_EQ(accepted(R"({"request":"impulse","force_n":-300,"duration_s":5e-4})"),
+            Request(ImpulseRequest{-300.0, 5e-4}));
+  EXPECT_EQ(rejected(R"({"request":"impulse","force_n":2e4,"duration_s":5e-4})"),
+            "impulse.force_n: 20000 is outside [-10000, 10000] N");
+  // Shorter than a loop period (1e-4 s in the test limits) would never reach the plant.
+  EXPECT_EQ(rejected(R"({"request":"impulse","force_n":300,"duration_s":1e-5})"),
+            "impulse.duration_s: 1e-05 is outside [0.0001, 1] s (one loop period at least)");
+  EXPECT_EQ(rejected(R"({"request":"impulse","force_n":300})"), "impulse.duration_s: missing");
+  EXPECT_NE(rejected(R"({"request":"impulse","force_n":300,"duration_s":1e-3,"x":1})").find('x'),
+            std::string::npos);
+}
+
 TEST(ControlProtocol, PeriodicWaves) {
   const Request sine = accepted(
       R"({"request":"wave","shape":"sine","amplitude":4e-4,"offset":6e-4,"frequency_hz":1,"phase":0.25,"repeat":3})");
@@ -257,13 +270,13 @@ TEST(ControlProtocol, WaveStopAndShapes) {
 }
 
 TEST(ControlProtocol, RequestMemberErrors) {
-  EXPECT_EQ(
-      rejected(R"({"value":1})"),
-      "request: missing (one of status, arm, disarm, reset, setpoint, mode, wave, record, reload)");
+  EXPECT_EQ(rejected(R"({"value":1})"),
+            "request: missing (one of status, arm, disarm, reset, setpoint, mode, wave, record, "
+            "reload, impulse)");
   EXPECT_EQ(rejected(R"({"request":7})"), "request: expected a string, got number");
   EXPECT_EQ(
       rejected(R"({"request":"launch"})"),
-      R"(request: "launch" is not a request (status, arm, disarm, reset, setpoint, mode, wave, record, reload))");
+      R"(request: "launch" is not a request (status, arm, disarm, reset, setpoint, mode, wave, record, reload, impulse))");
   // A long name is cut in the reply.
   const std::string error = rejected(R"({"request":")" + std::string(10'000, 'x') + R"("})");
   EXPECT_LT(error.size(), 200U);
@@ -375,6 +388,7 @@ TEST(ControlProtocol, EveryRequestRoundTrips) {
                                          ModeRequest{ControlMode::kOpenLoop},
                                          ModeRequest{ControlMode::kDamping},
                                          RecordRequest{RecordRequest::Action::kStop},
+                                         ImpulseRequest{250.0, 2e-3},
                                          WaveRequest{true, {}},
                                          WaveRequest{false, stairs},
                                          WaveRequest{false, table},

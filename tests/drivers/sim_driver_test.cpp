@@ -2,6 +2,8 @@
 // fault flag raised in any of them reaches the loop, not only one in the sample read last.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "selfsense/plant/config.hpp"
@@ -65,6 +67,49 @@ TEST(SimulatedTransducer, ASampleLateByALoopPeriodIsATimeoutAndOneLateByLessIsNo
   EXPECT_EQ(driver.read(sample), runtime::DriverStatus::kTimeout);
   EXPECT_EQ(driver.read(sample), runtime::DriverStatus::kOk);
   EXPECT_EQ(driver.counters().timeouts, 1U);
+}
+
+// The bench's force input (ctl impulse): a pulse of the force asked for, from the next cycle on,
+// for the cycles its duration lasts, on top of the constant load; the stack's stress shows it
+// in those cycles and only from them on (a twin without the pulse gives the same samples before).
+TEST(SimulatedTransducer, AForcePulseActsFromTheNextCycleForItsDuration) {
+  plant::PlantConfig config;
+  config.sample_rate_hz = kPlantRateHz;
+  config.mechanics.enabled = true;
+  config.mechanics.load_stiffness_n_per_m = 15e6;
+  SimulatedTransducer pushed(config);
+  SimulatedTransducer twin(config);
+  std::string why;
+  for (SimulatedTransducer* d : {&pushed, &twin}) {
+    ASSERT_TRUE(d->configure(runtime::DriverSetup{1.0 / kLoopRateHz}, &why)) << why;
+    ASSERT_TRUE(d->activate(&why)) << why;
+  }
+  runtime::ForceInput* input = pushed.force_input();
+  ASSERT_NE(input, nullptr);
+  runtime::InputSample a{};
+  runtime::InputSample b{};
+  for (int k = 0; k < 20; ++k) {
+    ASSERT_EQ(pushed.read(a), runtime::DriverStatus::kOk);
+    ASSERT_EQ(twin.read(b), runtime::DriverStatus::kOk);
+    EXPECT_EQ(a.t_ref, b.t_ref) << k;
+  }
+  input->apply(-500.0, 3.0 / kLoopRateHz);  // three cycles
+  double pushed_apart = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_EQ(pushed.read(a), runtime::DriverStatus::kOk);
+    ASSERT_EQ(twin.read(b), runtime::DriverStatus::kOk);
+    pushed_apart = std::max(pushed_apart, std::abs(a.t_ref - b.t_ref));
+  }
+  // 500 N on the stack's 10 mm x 10 mm face is 5 MPa: the dynamic stress follows a good part.
+  EXPECT_GT(pushed_apart, 1e5);
+  // After the pulse the two ring apart, then the difference decays (no force left).
+  double last = 0.0;
+  for (int k = 0; k < 2000; ++k) {
+    ASSERT_EQ(pushed.read(a), runtime::DriverStatus::kOk);
+    ASSERT_EQ(twin.read(b), runtime::DriverStatus::kOk);
+    last = std::abs(a.t_ref - b.t_ref);
+  }
+  EXPECT_LT(last, 0.01 * pushed_apart);
 }
 
 }  // namespace

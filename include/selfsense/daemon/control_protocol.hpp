@@ -12,6 +12,10 @@
 //   {"request": "wave", "shape": "table", "values": [0, 1e-4, 3e-4], "dt_s": 0.01, ...}
 //   {"request": "wave", "shape": "stop"}
 //   {"request": "record", "action": "start"}          start | stop
+//   {"request": "impulse", "force_n": 300, "duration_s": 5e-4}
+//                                                     a force pulse on the stack from the
+//                                                     bench (drivers with a force input: the
+//                                                     simulated transducer), for a ring-down
 // Parsing validates against RequestLimits, which the daemon fills from its configuration and
 // its active mode: a setpoint, and every value a wave can reach, must lie inside the active
 // mode's setpoint range. A rejected request gives one error that names the member
@@ -75,9 +79,16 @@ struct RecordRequest {
   bool operator==(const RecordRequest&) const = default;
 };
 
+// A rectangular force pulse on the stack through the driver's runtime::ForceInput.
+struct ImpulseRequest {
+  double force_n{0.0};     // [N], |force_n| <= RequestLimits::max_impulse_n
+  double duration_s{0.0};  // [s], in [sample_time, max_impulse_s]
+  bool operator==(const ImpulseRequest&) const = default;
+};
+
 using Request =
     std::variant<StatusRequest, ArmRequest, DisarmRequest, ResetRequest, SetpointRequest,
-                 ModeRequest, WaveRequest, RecordRequest, ReloadRequest>;
+                 ModeRequest, WaveRequest, RecordRequest, ReloadRequest, ImpulseRequest>;
 
 struct SetpointRange {
   double min{0.0};
@@ -96,6 +107,8 @@ struct RequestLimits {
   std::size_t max_levels{1024};        // staircase levels
   std::size_t max_table_values{4096};  // table values (a line must also fit the socket's limit)
   double max_dwell_s{3600.0};          // [s] staircase dwell per level, table dt
+  double max_impulse_n{1e4};           // [N] > 0, an impulse's force
+  double max_impulse_s{1.0};           // [s] >= sample_time, an impulse's duration
 
   // False, with the violated constraint in *why, when the limits themselves are unusable.
   [[nodiscard]] bool is_valid(std::string* why) const;

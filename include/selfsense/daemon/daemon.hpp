@@ -77,6 +77,8 @@ class Daemon final {
   [[nodiscard]] const DaemonConfig& config() const noexcept { return config_; }
   [[nodiscard]] Recorder& recorder() noexcept { return *recorder_; }
   [[nodiscard]] const runtime::Driver& driver() const noexcept { return *driver_; }
+  // The driver's bench force input, or null (runtime::ForceInput: thread-safe).
+  [[nodiscard]] runtime::ForceInput* force_input() noexcept { return driver_->force_input(); }
   // Real-time set-up problems; arming is refused while any exists unless degraded timing is
   // allowed by the configuration.
   [[nodiscard]] const runtime::RtSetupResult& rt_setup() const noexcept { return rt_setup_; }

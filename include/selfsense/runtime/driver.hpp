@@ -94,6 +94,23 @@ struct DriverCounters {
   }
 };
 
+// An external force a test bench can put on the stack on request (the simulated transducer's
+// load; on a rig, a shaker or an impact hammer the driver commands): a rectangular pulse of
+// `newtons` [N] for `seconds` [s] from the next cycle on, added to any constant load. For a
+// damping run's ring-down. Called from the control thread while the loop runs: apply() is
+// thread-safe and never blocks the loop.
+class ForceInput {
+ public:
+  ForceInput() = default;
+  ForceInput(const ForceInput&) = delete;
+  ForceInput& operator=(const ForceInput&) = delete;
+  ForceInput(ForceInput&&) = delete;
+  ForceInput& operator=(ForceInput&&) = delete;
+  virtual ~ForceInput() = default;
+  // newtons finite, seconds > 0; a pulse replaces one still running.
+  virtual void apply(double newtons, double seconds) noexcept = 0;
+};
+
 class Driver {
  public:
   Driver() = default;
@@ -121,6 +138,9 @@ class Driver {
   // When the device paces the loop (its data-ready edge starts each cycle), the trigger to wait
   // on instead of the timer; null otherwise (the default). Valid while the driver is active.
   [[nodiscard]] virtual CycleTrigger* cycle_trigger() noexcept { return nullptr; }
+  // The bench's force input when the driver has one (the simulated transducer); null otherwise
+  // (the default). Valid while the driver lives.
+  [[nodiscard]] virtual ForceInput* force_input() noexcept { return nullptr; }
 };
 
 }  // namespace selfsense::runtime
