@@ -44,7 +44,7 @@ ControllerConfig bench_control() {
 
 struct Bench {
   explicit Bench(const plant::PlantConfig& plant_config, const ControllerConfig& control,
-                 LoopConfig loop_config = {})
+                 LoopConfig loop_config = {}, const models::TransducerModel& model = bench_model())
       : driver(plant_config) {
     loop_config.sample_time = kTs;
     std::string why;
@@ -52,8 +52,8 @@ struct Bench {
     EXPECT_TRUE(driver.activate(&why)) << why;
     loop = std::make_unique<Loop>(
         loop_config, driver,
-        std::make_unique<models::Reconstruction>(bench_model(), models::RuntimeOptions{kTs}),
-        Controller(control, bench_model().actuator, kTs), nullptr);
+        std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{kTs}),
+        Controller(control, model.actuator, kTs), nullptr);
   }
   // Submits and runs cycles until the loop answered.
   CommandResult send(LoopCommand c) {
@@ -181,7 +181,7 @@ TEST(Loop, ForceTracksStepsOnTheSelfSensedStress) {
 // the stack rings at 300 Hz with 1 % damping after a 300 N, 0.5 ms force impulse. Armed in
 // open-loop (the inverse model holds the position) it rings down to 5 % of its first peak in
 // about 0.16 s; in damping mode (positive position feedback tuned to the mode) 14x faster.
-double ring_down_s(ControlMode mode) {
+double ring_down_s(ControlMode mode, const models::TransducerModel& model = bench_model()) {
   ControllerConfig c = bench_control();
   c.damping = {control::DampingController::Law::kPositivePosition,
                8e8,
@@ -189,7 +189,7 @@ double ring_down_s(ControlMode mode) {
                0.3,
                std::numeric_limits<double>::infinity(),
                20.0};
-  Bench b(test::daemon_plant(kRate, 300.0, 0.01), c);
+  Bench b(test::daemon_plant(kRate, 300.0, 0.01), c, {}, model);
   start(b, mode);
   b.send({0, CommandKind::kSetpoint, 6e-4});
   b.run(0.5);
@@ -216,6 +216,33 @@ TEST(Loop, DampingShortensTheRingDownTenfold) {
               open / damped);
   EXPECT_GT(open, 0.1);            // the undamped mode rings (measured 0.16 s)
   EXPECT_GT(open / damped, 10.0);  // the goal; measured 14x
+}
+
+// The paper's comparison (20x with a constant permittivity, 60x with eps(E)): the same damping
+// run with S_hat from models of the same recording that leave out the dielectric's
+// nonlinearity (linear: constant permittivity) or keep only its static curve (permittivity:
+// eps(E), no hysteresis), against the hysteresis-creep model above.
+TEST(Loop, DampingWithAConstantPermittivityAgainstEpsOfE) {
+  const plant::PlantConfig recorded = test::daemon_plant(kRate);
+  const models::TransducerModel linear =
+      test::identify_daemon_plant(recorded, 40.0, models::Structure::kLinear);
+  const models::TransducerModel eps_of_e =
+      test::identify_daemon_plant(recorded, 40.0, models::Structure::kPermittivity);
+  const double open = ring_down_s(ControlMode::kOpenLoop);
+  const double with_linear = ring_down_s(ControlMode::kDamping, linear);
+  const double with_eps = ring_down_s(ControlMode::kDamping, eps_of_e);
+  const double with_full = ring_down_s(ControlMode::kDamping);
+  std::printf(
+      "ring-down shortened: constant permittivity %.1fx, eps(E) %.1fx, hysteresis-creep "
+      "%.1fx\n",
+      open / with_linear, open / with_eps, open / with_full);
+  // Measured 12.0x, 8.1x and 14.6x. Not the paper's order: its eps(E) is the static curve, and
+  // around an operating point of a hysteretic stack the small ring follows the minor-loop slope,
+  // which the hysteresis model tracks after every reversal and the static curve does not.
+  EXPECT_GT(open / with_linear, 9.0);
+  EXPECT_GT(open / with_eps, 6.0);
+  EXPECT_GT(with_linear, 1.1 * with_full);
+  EXPECT_GT(with_eps, 1.1 * with_full);
 }
 
 // Every fault kind of the simulated transducer reaches the safe output in the cycle it shows

@@ -35,9 +35,11 @@ inline plant::PlantConfig daemon_plant(double sample_rate_hz, double resonance_h
   return c;
 }
 
-// Open loop: field sweeps of many sizes and offsets and a load varying independently of it.
-inline models::TransducerModel identify_daemon_plant(const plant::PlantConfig& config,
-                                                     double seconds) {
+// Open loop: field sweeps of many sizes and offsets and a load varying independently of it;
+// the model of `structure` (hysteresis-creep unless said) identified on that recording.
+inline models::TransducerModel identify_daemon_plant(
+    const plant::PlantConfig& config, double seconds,
+    models::Structure structure = models::Structure::kHysteresisCreep) {
   plant::Plant p(config);
   const double ts = 1.0 / config.sample_rate_hz;
   const auto n = static_cast<std::size_t>(seconds / ts);
@@ -69,9 +71,8 @@ inline models::TransducerModel identify_daemon_plant(const plant::PlantConfig& c
     s.push_back(o.s);
     t.push_back(o.t_pa);
   }
-  return identification::identify(
-      {e, d, t, s, ts * static_cast<double>(decimate)}, models::Structure::kHysteresisCreep,
-      identification::defaults_for(models::Structure::kHysteresisCreep));
+  return identification::identify({e, d, t, s, ts * static_cast<double>(decimate)}, structure,
+                                  identification::defaults_for(structure));
 }
 
 }  // namespace selfsense::test
