@@ -324,7 +324,9 @@ TEST(ModbusDriver, TcpGarbageAnswersAreCountedNeverANumber) {
 }
 
 // Two pseudo-terminals whose masters a thread joins: the device opens one slave, the driver
-// the other. In garbage mode the device's answers are replaced by random bytes.
+// the other. In garbage mode the device's answers are replaced by random bytes; in CRC mode the
+// last byte of each chunk of an answer (a whole frame at these rates: its CRC's high byte) is
+// inverted.
 class PtyBridge final {
  public:
   PtyBridge() {
@@ -356,6 +358,7 @@ class PtyBridge final {
   [[nodiscard]] const std::string& device_path() const { return sides_[0].path; }
   [[nodiscard]] const std::string& driver_path() const { return sides_[1].path; }
   void garbage(bool on) { garbage_ = on; }
+  void corrupt_crc(bool on) { corrupt_crc_ = on; }
 
  private:
   struct Side {
@@ -378,6 +381,10 @@ class PtyBridge final {
           for (ssize_t k = 0; k < n; ++k)
             buf[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(rng());
         }
+        if (i == 0 && corrupt_crc_) {
+          std::uint8_t& last = buf[static_cast<std::size_t>(n - 1)];
+          last = static_cast<std::uint8_t>(~last);
+        }
         static_cast<void>(::write(fds[1 - i].fd, buf.data(), static_cast<std::size_t>(n)));
       }
     }
@@ -385,6 +392,7 @@ class PtyBridge final {
   std::array<Side, 2> sides_{};
   std::atomic<bool> stop_{false};
   std::atomic<bool> garbage_{false};
+  std::atomic<bool> corrupt_crc_{false};
   std::thread thread_{};
 };
 
@@ -413,6 +421,18 @@ TEST(ModbusDriver, RtuOverAPseudoTerminalPairWithGarbageFrames) {
   EXPECT_GT(faults.bad_data + faults.timeouts, 5U);
 
   bridge.garbage(false);
+  EXPECT_GT(run_for(*d, 1000ms, 8.0e5).count(DriverStatus::kOk), 200);
+
+  // Answers whose CRC fails: counted as crc_errors (and bad data), never a number.
+  const std::uint64_t crc_before = d->counters().crc_errors;
+  bridge.corrupt_crc(true);
+  static_cast<void>(run_for(*d, 200ms, 8.0e5));
+  const Tally corrupted = run_for(*d, 600ms, 8.0e5);
+  EXPECT_EQ(corrupted.count(DriverStatus::kOk), 0);
+  const runtime::DriverCounters crc = d->counters();
+  EXPECT_GT(crc.crc_errors - crc_before, 50U);  // 250 polls a second for 0.8 s
+  EXPECT_LE(crc.crc_errors, crc.bad_data);
+  bridge.corrupt_crc(false);
   EXPECT_GT(run_for(*d, 1000ms, 8.0e5).count(DriverStatus::kOk), 200);
   d->deactivate();
   EXPECT_EQ(device.stop(SIGINT), 0) << "sim-device exits 0 on SIGINT";
