@@ -160,6 +160,7 @@ void read_safety(YamlMap s, SafetySection& out) {
     o->finish();
   }
   s.read("watchdog_s", out.watchdog_s);
+  s.read("stop_ramp_s", out.stop_ramp_s);
   s.finish();
 }
 
@@ -239,6 +240,8 @@ void validate(const DaemonConfig& c, Problems& p) {
           "safety.safe_value_v_per_m", "must be inside control.command_v_per_m");
   if (!s.overrun.is_valid(&why)) p.add(why);
   p.check(s.watchdog_s >= 0.0, "safety.watchdog_s", "must be >= 0");
+  p.check(s.stop_ramp_s >= 0.0 && s.stop_ramp_s <= 10.0, "safety.stop_ramp_s",
+          number(s.stop_ramp_s) + " must be within [0, 10] s");
   const RecorderSection& r = c.recorder;
   p.check(r.rotate_bytes >= 4096, "recorder.rotate_bytes", "must be >= 4096");
   p.check(r.flush_ms >= 1.0 && r.flush_ms <= 60000.0, "recorder.flush_ms",

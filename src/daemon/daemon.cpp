@@ -370,7 +370,22 @@ int Daemon::run() {
   }
   static_cast<void>(sd_notify(0, "STOPPING=1"));
   server_->stop();
-  // Safe output first: disarm (the loop writes the safe output from its next cycle), then stop.
+  // Safe output first, then stop. While armed the command ramps down to the safe output over
+  // safety.stop_ramp_s (a step would ring the mount: tension in a stack that does not take it);
+  // the loop disarms itself at the ramp's end. The disarm after it is for every other case.
+  const double ramp = config_.safety.stop_ramp_s;
+  if (ramp > 0.0 && loop_->status().state == runtime::LoopState::kArmed) {
+    const auto accepted =
+        command({0, runtime::CommandKind::kRampDown, ramp}, std::chrono::milliseconds(100));
+    if (accepted && accepted->result == runtime::CommandResult::kDone) {
+      const auto until =
+          std::chrono::steady_clock::now() + std::chrono::duration<double>(ramp + 0.5);
+      while (loop_->status().state == runtime::LoopState::kArmed &&
+             std::chrono::steady_clock::now() < until) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      }
+    }
+  }
   static_cast<void>(command({0, runtime::CommandKind::kDisarm}, std::chrono::milliseconds(100)));
   runner_->stop();
   driver_->deactivate();

@@ -1,5 +1,6 @@
 #include "selfsense/runtime/loop.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -105,7 +106,16 @@ void Loop::handle(const LoopCommand& c) noexcept {
       last_feed_ = cycle_;
       return answer(c, CommandResult::kDone);
     case CommandKind::kDisarm:
+      ramp_left_ = 0;
       return answer(c, supervisor_.disarm() ? CommandResult::kDone : CommandResult::kRefusedState);
+    case CommandKind::kRampDown: {
+      if (!supervisor_.armed()) return answer(c, CommandResult::kRefusedState);
+      if (!(c.value >= 0.0) || !std::isfinite(c.value)) return answer(c, CommandResult::kInvalid);
+      ramp_from_ = command_;
+      ramp_cycles_ = std::max<std::int64_t>(1, std::llround(c.value / config_.sample_time));
+      ramp_left_ = ramp_cycles_;
+      return answer(c, CommandResult::kDone);
+    }
     case CommandKind::kReset:
       if (supervisor_.state() != LoopState::kFaulted) {
         return answer(c, CommandResult::kRefusedState);
@@ -227,7 +237,14 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
 
   // control: the safe output unless armed and nothing went wrong in this cycle
   const double r = setpoint();
-  if (supervisor_.armed()) {
+  if (!supervisor_.armed()) ramp_left_ = 0;  // a fault or disarm ends a ramp at once
+  if (ramp_left_ > 0) {
+    const double safe = safe_command();
+    --ramp_left_;
+    command_ = safe + (ramp_from_ - safe) * static_cast<double>(ramp_left_) /
+                          static_cast<double>(ramp_cycles_);
+    if (ramp_left_ == 0) static_cast<void>(supervisor_.disarm());
+  } else if (supervisor_.armed()) {
     command_ = controller_.step(r, s_hat_, t_hat_);
   } else {
     command_ = safe_command();

@@ -78,7 +78,8 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
       if (phase == 20) c.kind = CommandKind::kArm;
       if (phase == 100) c = {id, CommandKind::kSetpoint, mode == ControlMode::kForce ? -6e6 : 5e-4};
       if (k == 5000) c = {id, CommandKind::kWave, 0.0, mode, wave.release()};
-      if (k == 25003) c.kind = CommandKind::kDisarm;  // a swap is refused while armed
+      if (phase == 20000) c = {id, CommandKind::kRampDown, 0.05};  // a ramped stop in each mode
+      if (k == 25003) c.kind = CommandKind::kDisarm;               // a swap is refused while armed
       if (k == 25005) {
         c = {id, CommandKind::kSwapModel, 0.0, mode, nullptr, next_model.release()};
         c.feedforward = next_feedforward.release();

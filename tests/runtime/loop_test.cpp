@@ -284,6 +284,43 @@ TEST(Loop, DampingWithAConstantPermittivityAgainstEpsOfE) {
   EXPECT_GT(with_eps, 1.1 * with_full);
 }
 
+// A ramped stop: from the last command straight down to the safe output in the cycles asked for,
+// then disarmed; refused unless armed; a fault during it goes to the safe output at once.
+TEST(Loop, ARampedStopReachesTheSafeOutputLinearlyThenDisarms) {
+  Bench b(test::daemon_plant(kRate), bench_control());
+  EXPECT_EQ(b.send({0, CommandKind::kRampDown, 0.01}), CommandResult::kRefusedState);
+  start(b, ControlMode::kPosition);
+  b.send({0, CommandKind::kSetpoint, 6e-4});
+  b.run(0.3);
+  const double from = b.loop->local_status().last.command;
+  ASSERT_GT(from, 5e5);
+  ASSERT_EQ(b.send({0, CommandKind::kRampDown, 100 * kTs}), CommandResult::kDone);
+  // send() ran the cycle that took the command: its first ramp cycle.
+  int k = 1;
+  EXPECT_NEAR(b.loop->local_status().last.command, from * 99.0 / 100.0, 1e-6 * from);
+  for (k = 2; k <= 100; ++k) {
+    b.loop->cycle(false);
+    const LoopSample& s = b.loop->local_status().last;
+    EXPECT_NEAR(s.command, from * (100.0 - k) / 100.0, 1e-6 * from) << k;
+    EXPECT_EQ(s.state, k < 100 ? LoopState::kArmed : LoopState::kReady) << k;
+  }
+  b.run(0.01);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kReady);
+  EXPECT_EQ(b.loop->local_status().last.command, 0.0);
+
+  // Armed again, ramping, then a fault: the safe output in the fault's cycle, latched.
+  ASSERT_EQ(b.send({0, CommandKind::kArm}), CommandResult::kDone);
+  b.send({0, CommandKind::kSetpoint, 6e-4});
+  b.run(0.3);
+  ASSERT_EQ(b.send({0, CommandKind::kRampDown, 0.5}), CommandResult::kDone);
+  b.run(0.01);
+  ASSERT_GT(b.loop->local_status().last.command, 1e5);
+  ASSERT_TRUE(b.driver.inject(plant::FaultKind::nan_sample, plant::Channel::d, 0, 3));
+  b.loop->cycle(false);
+  EXPECT_EQ(b.loop->local_status().last.state, LoopState::kFaulted);
+  EXPECT_EQ(b.loop->local_status().last.command, 0.0);
+}
+
 // Every fault kind of the simulated transducer reaches the safe output in the cycle it shows
 // up in, latches, and a reset afterwards re-arms.
 TEST(Loop, EveryFaultReachesTheSafeOutputInItsCycle) {

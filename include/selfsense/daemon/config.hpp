@@ -83,6 +83,7 @@ struct SafetySection {
   Range setpoint_stress_pa{-3e7, 1e7};
   runtime::OverrunPolicy overrun{};
   double watchdog_s{0.0};
+  double stop_ramp_s{0.05};  // SIGTERM while armed: ramp to the safe output over this; 0: step
   friend bool operator==(const SafetySection&, const SafetySection&) = default;
 };
 

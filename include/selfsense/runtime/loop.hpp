@@ -7,6 +7,10 @@
 // reconstruction, an estimate outside the configured physical range, the overrun policy and the
 // setpoint watchdog each latch a fault; the command written in the same cycle is then the safe
 // output (zero or hold, configured). While faulted or ready the safe output is written too.
+// A ramped stop (CommandKind::kRampDown over n cycles) writes, in its k-th cycle (k = 1..n),
+//   E[k] = E_safe + (E_0 - E_safe) (n - k) / n       (E_0: the last command before it)
+// with the controller left out, and disarms after the n-th: the stack is brought to the safe
+// output slower than its mount rings.
 //
 // Threads: cycle() runs on the real-time thread only. submit(), take_answer(), take_retired()
 // and status() are for one control thread (single producer / single consumer rings), status()
@@ -125,6 +129,10 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
   double t_hat_{0.0};
   bool estimate_valid_{false};
   std::uint32_t active_causes_{0};  // faults seen in the current cycle
+  // Ramped stop: the command it starts from, its length and the cycles left [cycles].
+  double ramp_from_{0.0};
+  std::int64_t ramp_cycles_{0};
+  std::int64_t ramp_left_{0};
 };
 
 }  // namespace selfsense::runtime

@@ -33,6 +33,10 @@ enum class CommandKind : std::uint8_t {
   kGains,      // position, force
   kSwapModel,  // model and, when not null, feedforward (ownership passes to the loop; the
                // model takes the running one's memory); refused while armed
+  kRampDown,   // value: seconds; while armed, the command ramps linearly from its last value
+               // to the safe output over that time, then the loop disarms (a stop that does not
+               // knock the stack; faults still go to the safe output at once); refused unless
+               // armed
 };
 
 struct LoopCommand {
