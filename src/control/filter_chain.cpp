@@ -29,6 +29,27 @@ bool FilterChain::set_section(std::size_t i, const BiquadCoefficients& coefficie
   return i < size_ && sections_[i].set_coefficients(coefficients);
 }
 
+bool FilterChain::assign(std::span<const BiquadCoefficients> sections, double input) noexcept {
+  if (sections.size() > kMaxSections) return false;
+  for (const BiquadCoefficients& c : sections) {
+    if (!c.is_stable()) return false;
+  }
+  double x = input;
+  for (std::size_t i = 0; i < sections.size(); ++i) {
+    const BiquadCoefficients& now = sections_[i].coefficients();
+    const BiquadCoefficients& next = sections[i];
+    const bool same = i < size_ && now.b0 == next.b0 && now.b1 == next.b1 && now.b2 == next.b2 &&
+                      now.a1 == next.a1 && now.a2 == next.a2;
+    if (!same) {
+      static_cast<void>(sections_[i].set_coefficients(next));
+      sections_[i].reset(x);
+    }
+    x *= next.dc_gain();
+  }
+  size_ = sections.size();
+  return true;
+}
+
 void FilterChain::reset(double x) noexcept {
   for (std::size_t i = 0; i < size_; ++i) {
     sections_[i].reset(x);

@@ -109,6 +109,13 @@ bool Pid::set_gains(const Gains& gains) noexcept {
   return true;
 }
 
+bool Pid::set_output_limits(double output_min, double output_max) noexcept {
+  if (std::isnan(output_min) || std::isnan(output_max) || !(output_max > output_min)) return false;
+  params_.output_min = output_min;
+  params_.output_max = output_max;
+  return true;
+}
+
 void Pid::reset() noexcept {
   integral_ = 0.0;
   derivative_ = 0.0;

@@ -116,6 +116,9 @@ nlohmann::json ControlHandler::status() {
   counters["estimate_status"] = estimate_status;
   const auto path = daemon_->recorder().current_path();
   const RunningParameters running = daemon_->parameters();
+  nlohmann::json filters = nlohmann::json::array();
+  for (const FilterSection& f : running.filters)
+    filters.push_back({{"type", f.type}, {"frequency_hz", f.frequency_hz}});
   nlohmann::json rt_problems = nlohmann::json::array();
   for (const std::string& p : daemon_->rt_setup().problems)
     rt_problems.push_back(p);
@@ -161,6 +164,8 @@ nlohmann::json ControlHandler::status() {
        {{"position",
          {{"kp", running.position.kp}, {"ki", running.position.ki}, {"kd", running.position.kd}}},
         {"force", {{"kp", running.force.kp}, {"ki", running.force.ki}, {"kd", running.force.kd}}}}},
+      {"command_v_per_m", {running.command_min, running.command_max}},
+      {"filters", filters},
   });
 }
 
@@ -218,7 +223,8 @@ nlohmann::json ControlHandler::handle(const Request& request, const PeerCredenti
   if (std::holds_alternative<ReloadRequest>(request)) {
     const ReloadResult reloaded = daemon_->reload();
     if (reloaded.ok()) {
-      return ok_reply({{"reloaded", reloaded.model ? "gains, model" : "gains"}});
+      return ok_reply({{"reloaded", reloaded.model ? "gains, filters, limits, model"
+                                                   : "gains, filters, limits"}});
     }
     std::string text;
     for (const std::string& p : reloaded.problems)

@@ -191,8 +191,6 @@ ReloadResult Daemon::reload() {
   };
   refuse(nc.mode != oc.mode, "control.mode");
   refuse(nc.feedforward != oc.feedforward, "control.feedforward");
-  refuse(nc.command_min != oc.command_min || nc.command_max != oc.command_max,
-         "control.command_v_per_m");
   refuse(nc.force_direction != oc.force_direction, "control.force_direction");
   refuse(without_gains(nc.position) != without_gains(oc.position),
          "control.position (only kp, ki, kd reload)");
@@ -201,7 +199,6 @@ ReloadResult Daemon::reload() {
   refuse(nc.position_shaper != oc.position_shaper, "control.position_shaper");
   refuse(nc.force_shaper != oc.force_shaper, "control.force_shaper");
   refuse(nc.damping != oc.damping, "control.damping");
-  refuse(n.filters != o.filters, "control.filters");
   refuse(n.safety != o.safety, "safety");
   refuse(n.recorder != o.recorder, "recorder");
   refuse(n.socket != o.socket, "socket");
@@ -254,24 +251,35 @@ ReloadResult Daemon::reload() {
     result.model = true;
   }
   runtime::LoopCommand c;
-  c.kind = runtime::CommandKind::kGains;
-  c.position = nc.position.gains;
-  c.force = nc.force.gains;
+  c.kind = runtime::CommandKind::kTune;
+  c.tuning = runtime::tuning_of(nc);
   const auto answer = command(c, std::chrono::milliseconds(500));
   if (!answer || answer->result != runtime::CommandResult::kDone) {
-    problems.push_back(config_.source.string() + ": control: the loop refused the new gains");
+    problems.push_back(config_.source.string() +
+                       ": control: the loop refused the new gains, filters or command limits");
     return result;
   }
   const std::lock_guard lock(parameters_mutex_);
   config_.control.position.gains = nc.position.gains;
   config_.control.force.gains = nc.force.gains;
-  result.gains = true;
+  config_.control.filters = nc.filters;
+  config_.control.filter_count = nc.filter_count;
+  config_.control.command_min = nc.command_min;
+  config_.control.command_max = nc.command_max;
+  config_.filters = n.filters;
+  result.tuning = true;
   return result;
 }
 
 RunningParameters Daemon::parameters() const {
   const std::lock_guard lock(parameters_mutex_);
-  return {config_.model, model_hash_, config_.control.position.gains, config_.control.force.gains};
+  return {config_.model,
+          model_hash_,
+          config_.control.position.gains,
+          config_.control.force.gains,
+          config_.filters,
+          config_.control.command_min,
+          config_.control.command_max};
 }
 
 void Daemon::notify_status() {
@@ -349,7 +357,7 @@ int Daemon::run() {
       for (const std::string& p : reloaded.problems)
         static_cast<void>(std::fprintf(stderr, "selfsensed: reload refused: %s\n", p.c_str()));
       if (reloaded.ok()) {
-        static_cast<void>(std::fprintf(stderr, "selfsensed: reloaded the gains%s\n",
+        static_cast<void>(std::fprintf(stderr, "selfsensed: reloaded gains, filters, limits%s\n",
                                        reloaded.model ? " and the model" : ""));
       }
       static_cast<void>(sd_notify(0, "READY=1"));

@@ -28,6 +28,17 @@ Feedforward make_feedforward(const ControllerConfig& config,
   return ff;
 }
 
+Tuning tuning_of(const ControllerConfig& config) noexcept {
+  Tuning t;
+  t.position = config.position.gains;
+  t.force = config.force.gains;
+  t.filters = config.filters;
+  t.filter_count = config.filter_count;
+  t.command_min = config.command_min;
+  t.command_max = config.command_max;
+  return t;
+}
+
 Controller::Controller(const ControllerConfig& config,
                        const std::optional<models::SideModel>& actuator, double sample_time)
     : config_(config),
@@ -112,13 +123,30 @@ void Controller::set_mode(ControlMode mode, double s_hat, double t_hat, double c
   arm(s_hat, t_hat, command);
 }
 
-bool Controller::set_gains(const control::Pid::Gains& position,
-                           const control::Pid::Gains& force) noexcept {
+bool Controller::tune(const Tuning& tuning) noexcept {
+  if (!std::isfinite(tuning.command_min) || !std::isfinite(tuning.command_max) ||
+      !(tuning.command_min < tuning.command_max) ||
+      tuning.filter_count > control::FilterChain::kMaxSections) {
+    return false;
+  }
   control::Pid trial_p = position_;
   control::Pid trial_f = force_;
-  if (!trial_p.set_gains(position) || !trial_f.set_gains(force)) return false;
+  control::FilterChain trial_chain = chain_;
+  if (!trial_p.set_gains(tuning.position) || !trial_f.set_gains(tuning.force) ||
+      !trial_p.set_output_limits(tuning.command_min, tuning.command_max) ||
+      !trial_f.set_output_limits(tuning.command_min, tuning.command_max) ||
+      !trial_chain.assign(std::span(tuning.filters).first(tuning.filter_count), last_command_)) {
+    return false;
+  }
   position_ = trial_p;
   force_ = trial_f;
+  chain_ = trial_chain;
+  config_.position.gains = tuning.position;
+  config_.force.gains = tuning.force;
+  config_.filters = tuning.filters;
+  config_.filter_count = tuning.filter_count;
+  config_.command_min = tuning.command_min;
+  config_.command_max = tuning.command_max;
   return true;
 }
 

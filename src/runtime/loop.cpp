@@ -150,9 +150,8 @@ void Loop::handle(const LoopCommand& c) noexcept {
       }
       wave_running_ = false;
       return answer(c, CommandResult::kDone);
-    case CommandKind::kGains:
-      return answer(c, controller_.set_gains(c.position, c.force) ? CommandResult::kDone
-                                                                  : CommandResult::kInvalid);
+    case CommandKind::kTune:
+      return answer(c, controller_.tune(c.tuning) ? CommandResult::kDone : CommandResult::kInvalid);
     case CommandKind::kSwapModel:
       // Not under a closed loop: the new model's estimate may differ from the old one's, and
       // a step of the estimate would be a step of the actuator. What is refused is handed back.

@@ -133,5 +133,44 @@ TEST(FilterChain, SetSectionSwapsStableCoefficientsOnly) {
   EXPECT_EQ(chain.section(0).a2, replacement.a2);
 }
 
+// A reload's new chain: a section that stays keeps its state, a changed or added one starts
+// settled (no bump on a constant input), an unstable one changes nothing.
+TEST(FilterChain, AssignKeepsStateSettlesAddedSectionsAndRefusesUnstableOnes) {
+  const std::array<BiquadCoefficients, 1> one{notch({500.0, 2.0, 0.0, 20.0}, kTs)};
+  FilterChain chain(one);
+  chain.reset(3.0);
+  for (int i = 0; i < 10; ++i)
+    EXPECT_NEAR(chain.step(3.0), 3.0, 1e-12);
+  const std::array<BiquadCoefficients, 3> three{notch({600.0, 2.0, 0.0, 20.0}, kTs),
+                                                low_pass(SecondOrderDesign{2000.0, 0.7071}, kTs),
+                                                low_pass(FirstOrderDesign{3000.0}, kTs)};
+  // A kept section keeps its state: mid-transient, the output goes on as without the assign.
+  FilterChain twin(one);
+  chain.reset(0.0);
+  twin.reset(0.0);
+  for (int i = 0; i < 5; ++i)
+    EXPECT_EQ(chain.step(1.0), twin.step(1.0));
+  ASSERT_TRUE(chain.assign(one, 123.0));
+  for (int i = 0; i < 5; ++i)
+    EXPECT_EQ(chain.step(1.0), twin.step(1.0));
+  chain.reset(3.0);
+  ASSERT_TRUE(chain.assign(three, 3.0));
+  EXPECT_EQ(chain.size(), 3U);
+  EXPECT_EQ(chain.section(1).b0, three[1].b0);
+  for (int i = 0; i < 10; ++i)
+    EXPECT_NEAR(chain.step(3.0), 3.0, 1e-9);  // steady, no transient from the added sections
+
+  BiquadCoefficients unstable = three[1];
+  unstable.a2 = 1.5;
+  const std::array<BiquadCoefficients, 2> bad{one[0], unstable};
+  EXPECT_FALSE(chain.assign(bad, 3.0));
+  EXPECT_EQ(chain.size(), 3U);
+  EXPECT_EQ(chain.section(0).b0, three[0].b0);
+  const std::array<BiquadCoefficients, 5> too_many{};
+  EXPECT_FALSE(chain.assign(too_many, 3.0));
+  EXPECT_TRUE(chain.assign({}, 0.0));
+  EXPECT_EQ(chain.step(7.0), 7.0);
+}
+
 }  // namespace
 }  // namespace selfsense::control

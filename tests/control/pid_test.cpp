@@ -192,5 +192,20 @@ TEST(Pid, TrackMakesTheIntegratorFollowAnOverriddenOutput) {
   EXPECT_NEAR(pid.step(1.0, 0.0), 0.25 + 20.0 * kTs * 1.0, 1e-15);
 }
 
+// A reload narrows the output range while running: the next output is clamped to it; invalid
+// limits change nothing.
+TEST(Pid, OutputLimitsChangeWhileRunning) {
+  Pid::Params p;
+  p.gains = {2.0, 0.0, 0.0};
+  Pid pid(p, 1e-3);
+  EXPECT_EQ(pid.step(10.0, 0.0), 20.0);
+  ASSERT_TRUE(pid.set_output_limits(-5.0, 5.0));
+  EXPECT_EQ(pid.step(10.0, 0.0), 5.0);
+  EXPECT_FALSE(pid.set_output_limits(1.0, 1.0));
+  EXPECT_FALSE(pid.set_output_limits(std::nan(""), 1.0));
+  EXPECT_EQ(pid.params().output_max, 5.0);
+  EXPECT_EQ(pid.step(-10.0, 0.0), -5.0);
+}
+
 }  // namespace
 }  // namespace selfsense::control

@@ -68,7 +68,7 @@ pid=$!
 for _ in $(seq 100); do [ -S "$out/reload.sock" ] && break; sleep 0.1; done
 ctl() { "$build/src/cli/selfsense" ctl --socket "$out/reload.sock" "$@"; }
 sed -i 's/kp: 2.0e8/kp: 1.0e8/' "$cfg"
-ctl reload | grep -q '"reloaded":"gains"' || fail "a gain change was not reloaded"
+ctl reload | grep -q '"reloaded":"gains, filters, limits"' || fail "a gain change was not reloaded"
 sed -i "s/rate_hz: 10000/rate_hz: 20000/" "$cfg"
 if reply=$(ctl reload); then fail "a rate change was accepted: $reply"; fi
 grep -q 'loop.rate_hz: cannot change while running' <<<"$reply" || fail "refusal does not name the key: $reply"

@@ -99,7 +99,7 @@ TEST(DaemonReload, OnlyAWholeValidFileIsTakenAndAModelOnlyWhileDisarmed) {
   testing::write_text(model_path, next_text);
   r = reload();
   ASSERT_TRUE(r.value("ok", false)) << r.dump();
-  EXPECT_EQ(r["reloaded"], "gains, model");
+  EXPECT_EQ(r["reloaded"], "gains, filters, limits, model");
   std::this_thread::sleep_for(std::chrono::milliseconds(100));  // status is published every 10 ms
   const nlohmann::json after = daemon.status();
   EXPECT_NE(after["model"]["hash"], hash0);
@@ -113,6 +113,65 @@ TEST(DaemonReload, OnlyAWholeValidFileIsTakenAndAModelOnlyWhileDisarmed) {
   const nlohmann::json tracking = daemon.status();
   EXPECT_EQ(tracking["state"], "armed") << tracking.dump();
   EXPECT_NEAR(tracking["estimate"]["S_hat"].get<double>(), 8e-4, 2e-5) << tracking.dump();
+  EXPECT_EQ(daemon.terminate(), 0);
+}
+
+// While armed and tracking, a reload takes new filters (a notch moved, a section added) and a
+// narrower command range in the next cycle: the command stays inside the new range and the loop
+// stays armed. A changed key that cannot change while running is refused by name with the rest.
+TEST(DaemonReload, FiltersAndCommandLimitsChangeWhileArmed) {
+  const testing::ScratchDir dir("daemon-reload-tuning");
+  const std::filesystem::path config = dir.path() / "selfsensed.yaml";
+  const std::filesystem::path source = SELFSENSE_SOURCE_DIR;
+  testing::write_text(dir.path() / "model.yaml",
+                      testing::read_text(source / "config" / "models" / "sim.yaml"));
+  const std::string config_text = testing::scratch_config(dir.path(), {});
+  testing::write_text(config, config_text);
+  RunningDaemon daemon(config, dir.path() / "control.sock", dir.path() / "selfsensed.log");
+  const nlohmann::json start = daemon.status();
+  ASSERT_EQ(start["filters"].size(), 2U) << start.dump();
+  EXPECT_EQ(start["filters"][0]["frequency_hz"], 2000.0);
+  EXPECT_EQ(start["command_v_per_m"][1], 2.0e6);
+  for (int i = 0; i < 100 && !daemon.request(R"({"request": "reset"})").value("ok", false); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_TRUE(daemon.request(R"({"request": "arm"})").value("ok", false));
+  ASSERT_TRUE(daemon.request(R"({"request": "setpoint", "value": 1.0e-3})").value("ok", false));
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
+  const double command = daemon.status()["estimate"]["command"];
+  ASSERT_GT(command, 1.0e6);  // the setpoint takes more than the new limit below
+
+  // Refused with the change of a key that needs a restart: nothing changes.
+  const auto with = [&](const std::vector<std::pair<std::string, std::string>>& edits) {
+    std::string text = config_text;
+    for (const auto& [from, to] : edits)
+      text.replace(text.find(from), from.size(), to);
+    return text;
+  };
+  const std::pair<std::string, std::string> narrower{"command_v_per_m: [0.0, 2.0e6]",
+                                                     "command_v_per_m: [0.0, 1.0e6]"};
+  const std::pair<std::string, std::string> new_filters{
+      "- {type: notch, frequency_hz: 2000.0,",
+      "- {type: low-pass-1, frequency_hz: 4000.0}\n    - {type: notch, frequency_hz: 1800.0,"};
+  testing::write_text(config, with({narrower, new_filters, {"priority: 80", "priority: 70"}}));
+  nlohmann::json r = daemon.request(R"({"request": "reload"})");
+  EXPECT_FALSE(r.value("ok", true)) << r.dump();
+  EXPECT_TRUE(contains(r.value("error", ""), "loop.priority: cannot change while running"))
+      << r.dump();
+  EXPECT_EQ(daemon.status()["command_v_per_m"][1], 2.0e6);
+
+  testing::write_text(config, with({narrower, new_filters}));
+  r = daemon.request(R"({"request": "reload"})");
+  ASSERT_TRUE(r.value("ok", false)) << r.dump();
+  EXPECT_EQ(r["reloaded"], "gains, filters, limits");
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const nlohmann::json after = daemon.status();
+  EXPECT_EQ(after["state"], "armed") << after.dump();
+  EXPECT_EQ(after["command_v_per_m"][1], 1.0e6);
+  ASSERT_EQ(after["filters"].size(), 3U) << after.dump();
+  EXPECT_EQ(after["filters"][0]["type"], "low-pass-1");
+  EXPECT_EQ(after["filters"][1]["frequency_hz"], 1800.0);
+  EXPECT_LE(after["estimate"]["command"].get<double>(), 1.0e6) << after.dump();
+  EXPECT_GE(after["estimate"]["command"].get<double>(), 0.99e6) << after.dump();  // saturated
   EXPECT_EQ(daemon.terminate(), 0);
 }
 

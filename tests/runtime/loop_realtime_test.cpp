@@ -4,6 +4,7 @@
 
 #include <memory>
 
+#include "selfsense/control/filter_design.hpp"
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/runtime/loop.hpp"
 #include "sim/simulated_transducer.hpp"
@@ -64,6 +65,17 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
   wc.frequency = 5.0;
   auto wave = std::make_unique<control::WaveGenerator>(wc, kTs);
 
+  // A reload's tuning while armed: a notch and a low-pass added, a narrower command range; and
+  // back to the configured chain (none) in the next mode.
+  Tuning tuned = tuning_of(cc);
+  tuned.filters[0] = control::notch({500.0, 2.0, 0.0, 20.0}, kTs);
+  tuned.filters[1] = control::low_pass(control::SecondOrderDesign{3000.0, 0.7071}, kTs);
+  tuned.filter_count = 2;
+  tuned.position = {1.2e8, 1e11, 0.0};
+  tuned.command_max = 1.8e6;
+  int tunes_done = 0;
+  std::uint64_t tune_id = 0;
+
   const ControlMode modes[] = {ControlMode::kPosition, ControlMode::kForce, ControlMode::kOpenLoop,
                                ControlMode::kDamping};
   std::uint64_t id = 0;
@@ -78,6 +90,11 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
       if (phase == 20) c.kind = CommandKind::kArm;
       if (phase == 100) c = {id, CommandKind::kSetpoint, mode == ControlMode::kForce ? -6e6 : 5e-4};
       if (k == 5000) c = {id, CommandKind::kWave, 0.0, mode, wave.release()};
+      if (phase == 10000) {
+        c = {id, CommandKind::kTune};
+        c.tuning = (k / 25000) % 2 == 0 ? tuned : tuning_of(cc);
+        tune_id = id;
+      }
       if (phase == 20000) c = {id, CommandKind::kRampDown, 0.05};  // a ramped stop in each mode
       if (k == 25003) c.kind = CommandKind::kDisarm;               // a swap is refused while armed
       if (k == 25005) {
@@ -93,11 +110,15 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
       loop.cycle(k % 5000 == 4999);
       LoopAnswer a;
       while (loop.take_answer(a)) {
+        if (a.id == tune_id && a.result == CommandResult::kDone) {
+          ++tunes_done;
+        }
       }
     }
     EXPECT_EQ(counter.count(), 0U);
     EXPECT_EQ(counter.locks(), 0U);
   }
+  EXPECT_EQ(tunes_done, 4);
   Retired r;
   while (loop.take_retired(r)) {
     delete r.wave;

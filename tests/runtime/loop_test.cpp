@@ -194,6 +194,35 @@ TEST(Loop, PositionAgainstOpenLoopFeedforwardAndTheUncompensatedLinearDrive) {
   EXPECT_LT(closed, 0.5 * feedforward);
 }
 
+// A reload's tuning while armed is all or nothing: with an unstable filter section it is
+// refused and the loop runs on as before; valid, the narrower command range holds from the
+// next cycle, and the loop stays armed.
+TEST(Loop, ATuningWhileArmedIsTakenAllOrNothing) {
+  Bench b(test::daemon_plant(kRate), bench_control());
+  start(b, ControlMode::kPosition);
+  b.send({0, CommandKind::kSetpoint, 1.1e-3});
+  b.run(0.3);
+  ASSERT_GT(b.loop->local_status().last.command, 1.5e6);
+
+  Tuning tuning = tuning_of(bench_control());
+  tuning.command_max = 1.2e6;
+  tuning.filters[0] = control::BiquadCoefficients{1.0, 0.0, 0.0, 0.0, 1.5};  // |a2| > 1
+  tuning.filter_count = 1;
+  LoopCommand c{0, CommandKind::kTune};
+  c.tuning = tuning;
+  EXPECT_EQ(b.send(c), CommandResult::kInvalid);
+  b.run(0.01);
+  EXPECT_GT(b.loop->local_status().last.command, 1.5e6);
+
+  tuning.filter_count = 0;
+  c.tuning = tuning;
+  EXPECT_EQ(b.send(c), CommandResult::kDone);
+  EXPECT_LE(b.loop->local_status().last.command, 1.2e6);
+  b.run(0.1);
+  EXPECT_EQ(b.loop->local_status().last.command, 1.2e6);  // saturated, and armed
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+}
+
 TEST(Loop, ForceTracksStepsOnTheSelfSensedStress) {
   Bench b(test::daemon_plant(kRate), bench_control());
   start(b, ControlMode::kForce);

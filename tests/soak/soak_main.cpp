@@ -283,7 +283,7 @@ int run(const Options& o) {
   const std::string err = read_text(work / "selfsensed.err");
   const std::size_t at = out.find("stopped at cycle ");
   report.stopped_cycle = at == std::string::npos ? 0 : std::stoll(out.substr(at + 17));
-  report.reloads_logged = count_of(err, "reloaded the gains");
+  report.reloads_logged = count_of(err, "reloaded gains, filters, limits");
   report.reloads_refused = count_of(err, "reload refused");
 
   RecordingExpectations expect;

@@ -4,7 +4,7 @@
 //
 // Sections run in the order given. An empty chain passes its input through.
 //
-// Real-time safe: step(), reset(), set_section(), save_state(), restore_state(). The
+// Real-time safe: step(), reset(), set_section(), assign(), save_state(), restore_state(). The
 // constructor validates and throws ParameterError.
 #pragma once
 
@@ -31,6 +31,12 @@ class FilterChain final {
   // Replaces section i (< size()) while running, keeping its state. False, and nothing changed,
   // when i is out of range or the coefficients are unstable.
   bool set_section(std::size_t i, const BiquadCoefficients& coefficients) noexcept;
+  // New sections while running (a reload): a section whose coefficients stay keeps its state;
+  // one that changes or is added starts settled at `input` scaled by the DC gain of the sections
+  // before it (what it sees at rest: the old state does not fit new coefficients), so a chain
+  // of unity-gain filters on a constant input does not bump. False, and nothing changed, when
+  // there are more than kMaxSections or a section is unstable.
+  bool assign(std::span<const BiquadCoefficients> sections, double input) noexcept;
 
   double step(double x) noexcept {
     for (std::size_t i = 0; i < size_; ++i)

@@ -28,8 +28,8 @@
 // back-calculation term, I[k+1] += g_t (u_applied - u[k]), g_t = Ts / Tt, or 1 (integrator set
 // so that v would have been u_applied) when Tt = 0.
 //
-// Real-time safe (noexcept, no allocation): step(), track(), set_gains(), reset(),
-// reset_bumpless(), save_state(), restore_state(). The constructor validates and throws
+// Real-time safe (noexcept, no allocation): step(), track(), set_gains(), set_output_limits(),
+// reset(), reset_bumpless(), save_state(), restore_state(). The constructor validates and throws
 // ParameterError naming the parameter.
 #pragma once
 
@@ -83,6 +83,9 @@ class Pid final {
   // Returns false and changes nothing when a gain is negative or not finite, or
   // derivative_filter_n > 0 and kp = 0 < kd.
   bool set_gains(const Gains& gains) noexcept;
+  // New output limits while running (a reload); the next step() clamps to them. False, and
+  // nothing changed, unless output_min < output_max (neither NaN).
+  bool set_output_limits(double output_min, double output_max) noexcept;
 
   // At rest: I = D = 0; the next step takes its measurement as the previous one.
   void reset() noexcept;

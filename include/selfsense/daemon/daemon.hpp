@@ -35,7 +35,7 @@ namespace selfsense::daemon {
 // What a reload did. When problems is not empty nothing changed.
 struct ReloadResult {
   std::vector<std::string> problems{};  // one line each, naming the file and the key
-  bool gains{false};                    // the PID gains were applied
+  bool tuning{false};                   // gains, filters and command limits were applied
   bool model{false};                    // a new model runs
   [[nodiscard]] bool ok() const noexcept { return problems.empty(); }
 };
@@ -46,6 +46,9 @@ struct RunningParameters {
   std::uint64_t model_hash{0};  // models::parameter_hash (models/model_identity.hpp)
   control::Pid::Gains position{};
   control::Pid::Gains force{};
+  std::vector<FilterSection> filters{};
+  double command_min{0.0};  // E [V/m]
+  double command_max{0.0};
 };
 
 class Daemon final {
@@ -87,9 +90,11 @@ class Daemon final {
     return rt_setup_.complete() || config_.loop.allow_degraded_timing;
   }
   // Reads the configuration file and the model file again; all or nothing. Applied while armed:
-  // the PID gains. Applied while disarmed: a model whose content changed (the same file
-  // rewritten, or another path), with the feedforward's inverse built from it; its memory is
-  // carried over (runtime_model.hpp, adopt_state). Any other changed key, a file that does not
+  // the PID gains, the filter chain (control.filters, control::FilterChain::assign) and the
+  // command limits (control.command_v_per_m), in one cycle (runtime::Controller::tune). Applied
+  // while disarmed: a model whose content changed (the same file rewritten, or another path),
+  // with the feedforward's inverse built from it; its memory is carried over
+  // (runtime_model.hpp, adopt_state). Any other changed key, a file that does not
   // load (half-written: a YAML or model error naming file and line) or a model change while
   // armed is refused by name and the running parameters stay.
   ReloadResult reload();

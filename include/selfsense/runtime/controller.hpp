@@ -21,7 +21,8 @@
 // PIDs so that the first command equals E_now. A mode change is allowed while disarmed; while
 // armed it is bumpless (the new mode starts from the measured state and the last command).
 //
-// Real-time safe after construction: step(), arm(), set_mode() are noexcept and allocate nothing.
+// Real-time safe after construction: step(), arm(), set_mode(), tune() are noexcept
+// and allocate nothing.
 #pragma once
 
 #include <array>
@@ -72,6 +73,20 @@ struct ControllerConfig {
   double command_max{2e6};
 };
 
+// What a reload may change while armed (Controller::tune): the PID gains, the filter chain and
+// the command limits.
+struct Tuning {
+  control::Pid::Gains position{};
+  control::Pid::Gains force{};
+  std::array<control::BiquadCoefficients, control::FilterChain::kMaxSections> filters{};
+  std::size_t filter_count{0};
+  double command_min{0.0};  // E [V/m]
+  double command_max{2e6};
+};
+
+// The tuning part of a configuration.
+[[nodiscard]] Tuning tuning_of(const ControllerConfig& config) noexcept;
+
 class Controller final {
  public:
   // actuator: the model's actuator side (for the feedforward); nullopt: no feedforward.
@@ -84,8 +99,13 @@ class Controller final {
   // Bumpless start at the measured state with the command now applied.
   void arm(double s_hat, double t_hat, double command) noexcept;
   void set_mode(ControlMode mode, double s_hat, double t_hat, double command) noexcept;
-  // Gains while running (no bump); false if invalid.
-  bool set_gains(const control::Pid::Gains& position, const control::Pid::Gains& force) noexcept;
+  // Gains, filters and command limits while running, all or nothing; false (nothing changed) if
+  // any is invalid. Gains without an output bump (control::Pid::set_gains); the filter chain
+  // by control::FilterChain::assign, changed and added sections settled at the last command;
+  // the limits act from the next step (a command outside them is clamped there, and the PIDs
+  // track the clamp as always).
+  bool tune(const Tuning& tuning) noexcept;
+  [[nodiscard]] Tuning tuning() const noexcept { return tuning_of(config_); }
 
   [[nodiscard]] ControlMode mode() const noexcept { return mode_; }
   [[nodiscard]] double shaped_setpoint() const noexcept { return shaped_; }

@@ -7,7 +7,7 @@
 
 #include <cstdint>
 
-#include "selfsense/control/pid.hpp"
+#include "selfsense/runtime/controller.hpp"
 #include "selfsense/runtime/loop_sample.hpp"
 
 namespace selfsense::control {
@@ -19,8 +19,6 @@ class Reconstruction;
 
 namespace selfsense::runtime {
 
-struct Feedforward;
-
 enum class CommandKind : std::uint8_t {
   kArm,
   kDisarm,
@@ -30,7 +28,7 @@ enum class CommandKind : std::uint8_t {
   kMode,       // mode
   kWave,       // wave (ownership passes to the loop)
   kStopWave,   // hold the wave's last value
-  kGains,      // position, force
+  kTune,       // tuning: gains, filters and command limits, all or nothing (a reload)
   kSwapModel,  // model and, when not null, feedforward (ownership passes to the loop; the
                // model takes the running one's memory); refused while armed
   kRampDown,   // value: seconds; while armed, the command ramps linearly from its last value
@@ -46,8 +44,7 @@ struct LoopCommand {
   ControlMode mode{ControlMode::kPosition};
   control::WaveGenerator* wave{nullptr};
   models::Reconstruction* model{nullptr};
-  control::Pid::Gains position{};
-  control::Pid::Gains force{};
+  Tuning tuning{};
   Feedforward* feedforward{nullptr};  // kSwapModel: the controller's new inverse model
 };
 
@@ -55,7 +52,7 @@ enum class CommandResult : std::uint8_t {
   kDone,
   kRefusedState,  // not allowed in the current state (arm while faulted, mode while armed...)
   kRefusedCause,  // reset while a fault cause is still active
-  kInvalid,       // rejected by the control law (gains)
+  kInvalid,       // rejected by the control law (gains, filters, limits)
 };
 
 struct LoopAnswer {
