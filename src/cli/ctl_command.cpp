@@ -191,6 +191,13 @@ void add_ctl_command(CLI::App& app) {
     send_request(*options, daemon::to_json(RecordRequest{kind}));
   });
 
+  auto state_action = std::make_shared<std::string>();
+  CLI::App* state =
+      ctl->add_subcommand("state", "Dump the model's memory into the recorder's directory");
+  state->fallthrough();
+  state->add_option("action", *state_action, "save")->required()->check(CLI::IsMember({"save"}));
+  state->callback([options] { send_request(*options, daemon::to_json(daemon::StateRequest{})); });
+
   auto force = std::make_shared<double>(0.0);
   auto duration = std::make_shared<double>(5e-4);
   CLI::App* impulse = ctl->add_subcommand(

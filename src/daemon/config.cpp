@@ -314,6 +314,9 @@ ConfigResult load_config(const std::filesystem::path& path, DriverSectionReader*
       l->finish();
     }
     c.model = base / root.required<std::string>("model");
+    std::string state;
+    root.read("model_state", state);
+    if (!state.empty()) c.model_state = base / state;
     YamlMap driver = root.map("driver");
     c.driver_type = driver.required<std::string>("type");
     c.driver_section = driver.canonical_text();

@@ -159,7 +159,10 @@ nlohmann::json ControlHandler::status() {
         {"S", number_or_null(s.last.s_ref)},
         {"T", number_or_null(s.last.t_ref)}}},
       {"wave_running", s.wave_running},
-      {"model", {{"path", running.model.string()}, {"hash", hex(running.model_hash)}}},
+      {"model",
+       {{"path", running.model.string()},
+        {"hash", hex(running.model_hash)},
+        {"state_at_start", daemon_->model_state_at_start()}}},
       {"gains",
        {{"position",
          {{"kp", running.position.kp}, {"ki", running.position.ki}, {"kd", running.position.kd}}},
@@ -210,6 +213,11 @@ nlohmann::json ControlHandler::handle(const Request& request, const PeerCredenti
     } catch (const std::exception& e) {
       return error_reply(std::string("record: ") + e.what());
     }
+  }
+  if (std::holds_alternative<StateRequest>(request)) {
+    const Daemon::StateSaved saved = daemon_->dump_model_state();
+    if (!saved.error.empty()) return error_reply("state: " + saved.error);
+    return ok_reply({{"path", saved.path.string()}});
   }
   if (const auto* i = std::get_if<ImpulseRequest>(&request)) {
     runtime::ForceInput* input = daemon_->force_input();

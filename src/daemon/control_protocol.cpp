@@ -16,8 +16,9 @@ namespace {
 using nlohmann::json;
 using Shape = control::WaveGenerator::Shape;
 
-constexpr std::array<std::string_view, 10> kRequestNames = {
-    "status", "arm", "disarm", "reset", "setpoint", "mode", "wave", "record", "reload", "impulse"};
+constexpr std::array<std::string_view, 11> kRequestNames = {
+    "status", "arm",    "disarm", "reset",   "setpoint", "mode",
+    "wave",   "record", "reload", "impulse", "state"};
 constexpr std::array<std::string_view, RequestLimits::kModes> kModeNames = {"position", "force",
                                                                             "open-loop", "damping"};
 // Echoed user strings are cut so an error reply stays short whatever was sent.
@@ -208,6 +209,13 @@ RecordRequest parse_record(const json& object) {
   reject(m.path("action") + ": " + echo(action) + " is not an action (start, stop)");
 }
 
+StateRequest parse_state(const json& object) {
+  const Members m(object, "state", {"action"}, "state");
+  const std::string action = m.text("action");
+  if (action == "save") return StateRequest{StateRequest::Action::kSave};
+  reject(m.path("action") + ": " + echo(action) + " is not an action (save)");
+}
+
 ImpulseRequest parse_impulse(const json& object, const RequestLimits& limits) {
   const Members m(object, "impulse", {"force_n", "duration_s"}, "impulse");
   const double force = m.number("force_n");
@@ -378,6 +386,7 @@ Request parse_object(const json& object, const RequestLimits& limits) {
   if (kind == "wave") return parse_wave(object, limits);
   if (kind == "record") return parse_record(object);
   if (kind == "impulse") return parse_impulse(object, limits);
+  if (kind == "state") return parse_state(object);
   reject("request: " + echo(kind) + " is not a request (" + joined(kRequestNames) + ")");
 }
 
@@ -510,6 +519,7 @@ nlohmann::json to_json(const Request& request) {
   if (const auto* record = std::get_if<RecordRequest>(&request)) {
     out["action"] = record->action == RecordRequest::Action::kStart ? "start" : "stop";
   }
+  if (std::holds_alternative<StateRequest>(request)) out["action"] = "save";
   if (const auto* impulse = std::get_if<ImpulseRequest>(&request)) {
     out["force_n"] = impulse->force_n;
     out["duration_s"] = impulse->duration_s;

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "selfsense/control/wave_generator.hpp"
+#include "selfsense/daemon/model_state_file.hpp"
 #include "selfsense/daemon/prometheus.hpp"
 #include "selfsense/daemon/recorder_metrics.hpp"
 #include "selfsense/daemon/telemetry_metrics.hpp"
@@ -21,6 +22,7 @@
 #include "selfsense/models/runtime_model.hpp"
 #include "selfsense/runtime/controller.hpp"
 #include "selfsense/runtime/supervisor.hpp"
+#include "utc_stamp.hpp"
 
 namespace selfsense::daemon {
 
@@ -72,6 +74,8 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
   model_text_ = models::model_to_string(model);
   model_hash_ = models::parameter_hash(model);
   auto reconstruction = std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts});
+  state_buffer_ = reconstruction->make_saved_state();
+  restore_model_state(*reconstruction);
   const runtime::Controller controller(config_.control, model.actuator, ts);
   std::string why;
   if (!driver_->configure({ts}, &why)) throw std::runtime_error("driver: " + why);
@@ -87,6 +91,64 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
                                           std::move(reconstruction), controller, sink_.get());
   runner_ = std::make_unique<runtime::LoopRunner>(
       *loop_, clock_, std::llround(ts * 1e9), rt_options(config_.loop), driver_->cycle_trigger());
+}
+
+void Daemon::restore_model_state(models::Reconstruction& model) {
+  const std::filesystem::path& path = config_.model_state;
+  if (path.empty()) return;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
+    state_at_start_ = "none";
+    return;
+  }
+  try {
+    const models::SavedState saved = read_model_state(path);
+    switch (model.restore_state(saved)) {
+      case models::RestoreResult::kOk:
+        // Taken once: after a crash the actuator's history is unknown, and a state from before
+        // it would be stale. The next clean stop writes it again.
+        std::filesystem::remove(path, ec);
+        state_at_start_ = "restored";
+        break;
+      case models::RestoreResult::kWrongModel:
+        state_at_start_ = "not restored: " + path.string() + ": written by another model";
+        break;
+      case models::RestoreResult::kWrongSize:
+        state_at_start_ = "not restored: " + path.string() + ": wrong number of values";
+        break;
+    }
+  } catch (const std::exception& e) {
+    state_at_start_ = std::string("not restored: ") + e.what();
+  }
+  static_cast<void>(std::fprintf(stderr, "selfsensed: model state: %s\n", state_at_start_.c_str()));
+}
+
+Daemon::StateSaved Daemon::save_model_state(const std::filesystem::path& path) {
+  StateSaved out;
+  const std::lock_guard lock(state_mutex_);
+  runtime::LoopCommand c;
+  c.kind = runtime::CommandKind::kSaveState;
+  c.state = &state_buffer_;
+  const auto answer = command(c, std::chrono::milliseconds(500));
+  if (!answer || answer->result != runtime::CommandResult::kDone) {
+    out.error = "the loop did not save the model's state";
+    return out;
+  }
+  try {
+    write_model_state(path, state_buffer_);
+  } catch (const std::exception& e) {
+    out.error = e.what();
+    return out;
+  }
+  out.path = path;
+  return out;
+}
+
+Daemon::StateSaved Daemon::dump_model_state() {
+  const std::string name = "model-state-" +
+                           detail::utc_stamp(std::chrono::system_clock::now(), true) + "-cycle" +
+                           std::to_string(loop_->status().cycle) + ".yaml";
+  return save_model_state(config_.recorder.directory / name);
 }
 
 Daemon::~Daemon() {
@@ -181,6 +243,7 @@ ReloadResult Daemon::reload() {
   refuse(n.loop.allow_degraded_timing != o.loop.allow_degraded_timing,
          "loop.allow_degraded_timing");
   refuse(n.loop.status_period_cycles != o.loop.status_period_cycles, "loop.status_period_cycles");
+  refuse(n.model_state != o.model_state, "model_state");
   refuse(n.driver_type != o.driver_type, "driver.type");
   refuse(n.driver_type == o.driver_type && n.driver_section != o.driver_section, "driver");
   const runtime::ControllerConfig& nc = n.control;
@@ -225,6 +288,7 @@ ReloadResult Daemon::reload() {
   if (!problems.empty()) return result;
 
   if (reconstruction) {
+    models::SavedState next_buffer = reconstruction->make_saved_state();
     runtime::LoopCommand c;
     c.kind = runtime::CommandKind::kSwapModel;
     c.model = reconstruction.get();
@@ -243,6 +307,10 @@ ReloadResult Daemon::reload() {
                  "reload"
                : ": the loop did not take the new model"));
       return result;
+    }
+    {
+      const std::lock_guard state_lock(state_mutex_);
+      state_buffer_ = std::move(next_buffer);
     }
     const std::lock_guard lock(parameters_mutex_);
     config_.model = n.model;
@@ -395,6 +463,13 @@ int Daemon::run() {
     }
   }
   static_cast<void>(command({0, runtime::CommandKind::kDisarm}, std::chrono::milliseconds(100)));
+  if (!config_.model_state.empty()) {
+    const StateSaved saved = save_model_state(config_.model_state);
+    if (!saved.error.empty()) {
+      static_cast<void>(
+          std::fprintf(stderr, "selfsensed: model state not saved: %s\n", saved.error.c_str()));
+    }
+  }
   runner_->stop();
   driver_->deactivate();
   recorder_->stop();

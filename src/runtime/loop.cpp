@@ -108,6 +108,10 @@ void Loop::handle(const LoopCommand& c) noexcept {
     case CommandKind::kDisarm:
       ramp_left_ = 0;
       return answer(c, supervisor_.disarm() ? CommandResult::kDone : CommandResult::kRefusedState);
+    case CommandKind::kSaveState:
+      return answer(c, c.state != nullptr && model_->save_state(*c.state)
+                           ? CommandResult::kDone
+                           : CommandResult::kInvalid);
     case CommandKind::kRampDown: {
       if (!supervisor_.armed()) return answer(c, CommandResult::kRefusedState);
       if (!(c.value >= 0.0) || !std::isfinite(c.value)) return answer(c, CommandResult::kInvalid);

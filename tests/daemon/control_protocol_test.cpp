@@ -120,6 +120,14 @@ TEST(ControlProtocol, Impulse) {
             std::string::npos);
 }
 
+TEST(ControlProtocol, State) {
+  EXPECT_EQ(accepted(R"({"request":"state","action":"save"})"), Request(StateRequest{}));
+  EXPECT_EQ(rejected(R"({"request":"state","action":"load"})"),
+            R"(state.action: "load" is not an action (save))");
+  EXPECT_EQ(rejected(R"({"request":"state"})"), "state.action: missing");
+  EXPECT_EQ(to_json(StateRequest{}).dump(), R"({"action":"save","request":"state"})");
+}
+
 TEST(ControlProtocol, PeriodicWaves) {
   const Request sine = accepted(
       R"({"request":"wave","shape":"sine","amplitude":4e-4,"offset":6e-4,"frequency_hz":1,"phase":0.25,"repeat":3})");
@@ -272,11 +280,11 @@ TEST(ControlProtocol, WaveStopAndShapes) {
 TEST(ControlProtocol, RequestMemberErrors) {
   EXPECT_EQ(rejected(R"({"value":1})"),
             "request: missing (one of status, arm, disarm, reset, setpoint, mode, wave, record, "
-            "reload, impulse)");
+            "reload, impulse, state)");
   EXPECT_EQ(rejected(R"({"request":7})"), "request: expected a string, got number");
   EXPECT_EQ(
       rejected(R"({"request":"launch"})"),
-      R"(request: "launch" is not a request (status, arm, disarm, reset, setpoint, mode, wave, record, reload, impulse))");
+      R"(request: "launch" is not a request (status, arm, disarm, reset, setpoint, mode, wave, record, reload, impulse, state))");
   // A long name is cut in the reply.
   const std::string error = rejected(R"({"request":")" + std::string(10'000, 'x') + R"("})");
   EXPECT_LT(error.size(), 200U);
@@ -389,6 +397,7 @@ TEST(ControlProtocol, EveryRequestRoundTrips) {
                                          ModeRequest{ControlMode::kDamping},
                                          RecordRequest{RecordRequest::Action::kStop},
                                          ImpulseRequest{250.0, 2e-3},
+                                         StateRequest{},
                                          WaveRequest{true, {}},
                                          WaveRequest{false, stairs},
                                          WaveRequest{false, table},

@@ -73,7 +73,10 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
   tuned.filter_count = 2;
   tuned.position = {1.2e8, 1e11, 0.0};
   tuned.command_max = 1.8e6;
+  models::SavedState state = next_model->make_saved_state();  // a state dump's buffer
   int tunes_done = 0;
+  int states_saved = 0;
+  std::uint64_t state_id = 0;
   std::uint64_t tune_id = 0;
 
   const ControlMode modes[] = {ControlMode::kPosition, ControlMode::kForce, ControlMode::kOpenLoop,
@@ -95,6 +98,11 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
         c.tuning = (k / 25000) % 2 == 0 ? tuned : tuning_of(cc);
         tune_id = id;
       }
+      if (phase == 15000) {
+        c = {id, CommandKind::kSaveState};
+        c.state = &state;
+        state_id = id;
+      }
       if (phase == 20000) c = {id, CommandKind::kRampDown, 0.05};  // a ramped stop in each mode
       if (k == 25003) c.kind = CommandKind::kDisarm;               // a swap is refused while armed
       if (k == 25005) {
@@ -110,15 +118,15 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
       loop.cycle(k % 5000 == 4999);
       LoopAnswer a;
       while (loop.take_answer(a)) {
-        if (a.id == tune_id && a.result == CommandResult::kDone) {
-          ++tunes_done;
-        }
+        if (a.id == tune_id && a.result == CommandResult::kDone) ++tunes_done;
+        if (a.id == state_id && a.result == CommandResult::kDone) ++states_saved;
       }
     }
     EXPECT_EQ(counter.count(), 0U);
     EXPECT_EQ(counter.locks(), 0U);
   }
   EXPECT_EQ(tunes_done, 4);
+  EXPECT_EQ(states_saved, 4);
   Retired r;
   while (loop.take_retired(r)) {
     delete r.wave;

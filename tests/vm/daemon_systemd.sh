@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Host side of payload/daemon_systemd.sh: selfsensed under systemd as PID 1 (Type=notify,
-# watchdog restart of a frozen daemon, restart faulted after kill -9, clean stop).
+# watchdog restart of a frozen daemon, restart faulted after kill -9, clean stop, the model's
+# memory written at the stop).
 #   tests/vm/daemon_systemd.sh OUT_DIR   (after tests/vm/boot.sh OUT_DIR ...)
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=lib.sh
@@ -21,4 +22,5 @@ vm_check_test "${1:?usage: tests/vm/daemon_systemd.sh OUT_DIR}" daemon_systemd \
   'state_after_kill9=faulted' \
   'is-active_after_stop=inactive' \
   'exit_status=0' \
-  'clean_stop_logged=yes'
+  'clean_stop_logged=yes' \
+  'model_state_written=yes'

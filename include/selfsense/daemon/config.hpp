@@ -6,6 +6,8 @@
 //   loop: {rate_hz, priority, cpu, allow_degraded_timing, status_period_cycles}
 //   model: PATH                         # a model file from `selfsense identify` (relative paths
 //                                       # are relative to this file)
+//   model_state: PATH                   # optional: the model's memory, written at a clean stop
+//                                       # and taken at the next start (model_state_file.hpp)
 //   driver: {type: simulated, plant: PATH, ...}     # the driver's own keys, see drivers/
 //   control:
 //     mode: position | force | open-loop | damping
@@ -114,6 +116,7 @@ struct DaemonConfig {
   std::filesystem::path source{};  // the file it was read from
   LoopSection loop{};
   std::filesystem::path model{};
+  std::filesystem::path model_state{};  // the model's memory across restarts; empty: not kept
   std::string driver_type{};
   std::string driver_section{};  // the `driver` mapping as text (a reload compares it)
   runtime::ControllerConfig control{};

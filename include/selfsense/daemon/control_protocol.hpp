@@ -12,6 +12,7 @@
 //   {"request": "wave", "shape": "table", "values": [0, 1e-4, 3e-4], "dt_s": 0.01, ...}
 //   {"request": "wave", "shape": "stop"}
 //   {"request": "record", "action": "start"}          start | stop
+//   {"request": "state", "action": "save"}            a dump of the model's memory
 //   {"request": "impulse", "force_n": 300, "duration_s": 5e-4}
 //                                                     a force pulse on the stack from the
 //                                                     bench (drivers with a force input: the
@@ -79,6 +80,13 @@ struct RecordRequest {
   bool operator==(const RecordRequest&) const = default;
 };
 
+// A dump of the model's memory into the recorder's directory (daemon.hpp, dump_model_state).
+struct StateRequest {
+  enum class Action : std::uint8_t { kSave };
+  Action action{Action::kSave};
+  bool operator==(const StateRequest&) const = default;
+};
+
 // A rectangular force pulse on the stack through the driver's runtime::ForceInput.
 struct ImpulseRequest {
   double force_n{0.0};     // [N], |force_n| <= RequestLimits::max_impulse_n
@@ -86,9 +94,9 @@ struct ImpulseRequest {
   bool operator==(const ImpulseRequest&) const = default;
 };
 
-using Request =
-    std::variant<StatusRequest, ArmRequest, DisarmRequest, ResetRequest, SetpointRequest,
-                 ModeRequest, WaveRequest, RecordRequest, ReloadRequest, ImpulseRequest>;
+using Request = std::variant<StatusRequest, ArmRequest, DisarmRequest, ResetRequest,
+                             SetpointRequest, ModeRequest, WaveRequest, RecordRequest,
+                             ReloadRequest, ImpulseRequest, StateRequest>;
 
 struct SetpointRange {
   double min{0.0};

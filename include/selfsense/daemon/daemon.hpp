@@ -25,6 +25,7 @@
 #include "selfsense/daemon/control_handler.hpp"
 #include "selfsense/daemon/control_server.hpp"
 #include "selfsense/daemon/recorder.hpp"
+#include "selfsense/models/model_identity.hpp"
 #include "selfsense/runtime/driver.hpp"
 #include "selfsense/runtime/loop.hpp"
 #include "selfsense/runtime/loop_runner.hpp"
@@ -100,6 +101,18 @@ class Daemon final {
   ReloadResult reload();
   // What runs now (any thread; a reload changes it).
   [[nodiscard]] RunningParameters parameters() const;
+  // The model's memory (model_state_file.hpp), copied by the loop at a cycle boundary into
+  // recorder.directory/model-state-UTC-cycleN.yaml: a dump to look at or to copy to a
+  // model_state file. The file's path, or an error naming what failed.
+  struct StateSaved {
+    std::filesystem::path path{};
+    std::string error{};
+  };
+  StateSaved dump_model_state();
+  // The configured model_state file is written at a clean stop and taken (read, then removed)
+  // at the next start, so a crash leaves none. What happened to it at start: "restored",
+  // "none" (no file), "not restored: WHY", or "off" (no model_state configured).
+  [[nodiscard]] const std::string& model_state_at_start() const noexcept { return state_at_start_; }
   // Test hook for the watchdog: the loop stops making progress.
   void stall_loop(bool on) noexcept { runner_->stall(on); }
   void request_stop() noexcept { stop_requested_.store(true); }
@@ -107,6 +120,8 @@ class Daemon final {
  private:
   class Sink;
   void free_retired();
+  void restore_model_state(models::Reconstruction& model);
+  StateSaved save_model_state(const std::filesystem::path& path);
   void notify_status();
   void write_telemetry();
 
@@ -127,6 +142,9 @@ class Daemon final {
   std::string model_text_{};  // the running model as models::model_to_string writes it
   std::uint64_t model_hash_{0};
   mutable std::mutex parameters_mutex_{};  // config_.model, model_hash_, the gains: reload writes
+  std::mutex state_mutex_{};               // state_buffer_: the loop writes it while one waits
+  models::SavedState state_buffer_{};      // sized for the running model
+  std::string state_at_start_{"off"};
 };
 
 }  // namespace selfsense::daemon

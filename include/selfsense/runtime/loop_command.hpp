@@ -15,7 +15,8 @@ class WaveGenerator;
 }
 namespace selfsense::models {
 class Reconstruction;
-}
+struct SavedState;
+}  // namespace selfsense::models
 
 namespace selfsense::runtime {
 
@@ -31,6 +32,8 @@ enum class CommandKind : std::uint8_t {
   kTune,       // tuning: gains, filters and command limits, all or nothing (a reload)
   kSwapModel,  // model and, when not null, feedforward (ownership passes to the loop; the
                // model takes the running one's memory); refused while armed
+  kSaveState,  // state: the model's state is saved into it (sized by make_saved_state() for the
+               // running model); kInvalid when it does not fit
   kRampDown,   // value: seconds; while armed, the command ramps linearly from its last value
                // to the safe output over that time, then the loop disarms (a stop that does not
                // knock the stack; faults still go to the safe output at once); refused unless
@@ -45,7 +48,8 @@ struct LoopCommand {
   control::WaveGenerator* wave{nullptr};
   models::Reconstruction* model{nullptr};
   Tuning tuning{};
-  Feedforward* feedforward{nullptr};  // kSwapModel: the controller's new inverse model
+  Feedforward* feedforward{nullptr};   // kSwapModel: the controller's new inverse model
+  models::SavedState* state{nullptr};  // kSaveState: owned by the sender, who waits for the answer
 };
 
 enum class CommandResult : std::uint8_t {

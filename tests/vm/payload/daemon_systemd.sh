@@ -100,3 +100,8 @@ echo "exit_status=$(prop ExecMainStatus)"
 if journalctl -b -u "$unit" --no-pager | grep -q 'selfsensed: stopped at cycle'; then
   echo "clean_stop_logged=yes"
 fi
+# The model's memory, written at the clean stop into the StateDirectory (ProtectSystem=strict).
+if [ -s /var/lib/selfsensed/model-state.yaml ] &&
+  tail -n 1 /var/lib/selfsensed/model-state.yaml | grep -q '^complete: true$'; then
+  echo "model_state_written=yes"
+fi

@@ -1,0 +1,30 @@
+// The running model's state on disk (models::SavedState): the hysteresis and creep memory of the
+// self-sensing model, so that a restart goes on from the actuator's history instead of the
+// identification recording's start. The daemon writes its `model_state` file at a clean stop
+// and takes it (reads, then removes it) at the next start; restored only into the model that
+// wrote it (identity check). The control socket's `state` request dumps the same format into
+// the recorder's directory.
+//
+//   selfsense_model_state: 1
+//   structure: hysteresis-creep
+//   parameter_hash: "0123456789abcdef"   # models::parameter_hash, hexadecimal
+//   values: [v0, v1, ...]                 # %.17g: the doubles round-trip exactly
+//   complete: true                        # last: a file cut anywhere is refused
+//
+// Not real-time code: it allocates, does file I/O and throws.
+#pragma once
+
+#include <filesystem>
+
+#include "selfsense/models/model_identity.hpp"
+
+namespace selfsense::daemon {
+
+// Writes beside `path` and renames over it, so a reader never sees half a file. Throws
+// std::runtime_error naming the path.
+void write_model_state(const std::filesystem::path& path, const models::SavedState& state);
+
+// Throws io::YamlError ("file:line: key: ...") on a malformed or cut file.
+[[nodiscard]] models::SavedState read_model_state(const std::filesystem::path& path);
+
+}  // namespace selfsense::daemon

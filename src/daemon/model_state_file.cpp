@@ -1,0 +1,70 @@
+#include "selfsense/daemon/model_state_file.hpp"
+
+#include <cinttypes>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "selfsense/io/yaml_map.hpp"
+
+namespace selfsense::daemon {
+
+void write_model_state(const std::filesystem::path& path, const models::SavedState& state) {
+  std::string text = "selfsense_model_state: 1\nstructure: ";
+  text += models::to_string(state.identity.structure);
+  char hash[32];
+  static_cast<void>(std::snprintf(hash, sizeof hash, "%016" PRIx64, state.identity.parameter_hash));
+  text += std::string("\nparameter_hash: \"") + hash + "\"\nvalues: [";
+  char number[32];
+  for (std::size_t i = 0; i < state.values.size(); ++i) {
+    static_cast<void>(std::snprintf(number, sizeof number, "%.17g", state.values[i]));
+    text += (i == 0 ? "" : ", ") + std::string(number);
+  }
+  text += "]\ncomplete: true\n";
+  std::filesystem::path temporary = path;
+  temporary += ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.flush();
+    if (!out) throw std::runtime_error(temporary.string() + ": cannot write the model state");
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec)
+    throw std::runtime_error(path.string() + ": cannot replace the model state: " + ec.message());
+}
+
+models::SavedState read_model_state(const std::filesystem::path& path) {
+  io::YamlMap root = io::YamlMap::load_file(path);
+  if (root.required<int>("selfsense_model_state") != 1) {
+    root.fail("selfsense_model_state", "unknown format (this version reads 1)");
+  }
+  if (root.last_key() != "complete" || !root.required<bool>("complete")) {
+    root.fail("complete", "missing at the end: the file is cut (written while it was read?)");
+  }
+  models::SavedState state;
+  const std::string structure = root.required<std::string>("structure");
+  const auto parsed = models::parse_structure(structure);
+  if (!parsed) root.fail("structure", "unknown structure '" + structure + "'");
+  state.identity.structure = *parsed;
+  const std::string hash = root.required<std::string>("parameter_hash");
+  std::size_t used = 0;
+  try {
+    state.identity.parameter_hash = std::stoull(hash, &used, 16);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != hash.size()) {
+    root.fail("parameter_hash", "expected 16 hexadecimal digits");
+  }
+  if (!root.has("values")) root.fail("values", "missing");
+  root.read_sequence("values", state.values);
+  state.identity.state_size = state.values.size();
+  root.finish();
+  return state;
+}
+
+}  // namespace selfsense::daemon

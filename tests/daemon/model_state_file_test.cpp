@@ -1,0 +1,104 @@
+// The model's memory on disk: written whole (beside the file, then renamed), read back bit for
+// bit into the model that wrote it and refused by another; a cut or malformed file is named by
+// file, line and key.
+#include "selfsense/daemon/model_state_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include "daemon/recording_support.hpp"
+#include "selfsense/io/yaml_map.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
+#include "selfsense/models/runtime_model.hpp"
+
+namespace selfsense::daemon {
+namespace {
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+}
+
+std::string error_of(const std::filesystem::path& path) {
+  try {
+    static_cast<void>(read_model_state(path));
+  } catch (const io::YamlError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ModelStateFile, TheMemoryRoundTripsExactlyIntoItsOwnModelOnly) {
+  const testing::ScratchDir dir("model-state");
+  const std::filesystem::path source = SELFSENSE_SOURCE_DIR;
+  const models::TransducerModel model =
+      models::load_model(source / "config" / "models" / "sim.yaml");
+  models::Reconstruction running(model, models::RuntimeOptions{1e-4});
+  for (int k = 0; k < 20000; ++k) {  // a history far from the identification's start
+    const double e = 1.6e6 * std::sin(0.0007 * k) * std::exp(-1e-4 * k) + 2e5;
+    static_cast<void>(running.step(e, 0.03 + 1e-8 * e));
+  }
+  models::SavedState saved = running.make_saved_state();
+  ASSERT_TRUE(running.save_state(saved));
+  const std::filesystem::path path = dir.path() / "state.yaml";
+  write_model_state(path, saved);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "state.yaml.tmp"));
+
+  const models::SavedState read = read_model_state(path);
+  EXPECT_EQ(read.identity, saved.identity);
+  EXPECT_EQ(read.values, saved.values);  // %.17g round-trips every double exactly
+  models::Reconstruction restored(model, models::RuntimeOptions{1e-4});
+  ASSERT_EQ(restored.restore_state(read), models::RestoreResult::kOk);
+  for (int k = 0; k < 100; ++k) {
+    const auto a = running.step(3e5, 0.031);
+    const auto b = restored.step(3e5, 0.031);
+    EXPECT_EQ(a.strain, b.strain);
+    EXPECT_EQ(a.stress, b.stress);
+  }
+
+  models::TransducerModel other = model;
+  other.actuator->offset += 1e-6;
+  models::Reconstruction another(other, models::RuntimeOptions{1e-4});
+  EXPECT_EQ(another.restore_state(read), models::RestoreResult::kWrongModel);
+}
+
+TEST(ModelStateFile, ACutOrMalformedFileIsNamedByLineAndKey) {
+  const testing::ScratchDir dir("model-state-bad");
+  models::SavedState s;
+  s.identity = {models::Structure::kHysteresisCreep, 0x0123456789abcdefULL, 3};
+  s.values = {1.0, 0.5, 3.0};
+  const std::filesystem::path path = dir.path() / "state.yaml";
+  write_model_state(path, s);
+  const std::string text = read_text(path);
+  const std::filesystem::path bad = dir.path() / "bad.yaml";
+
+  write_text(bad, text.substr(0, text.find("complete")));
+  EXPECT_NE(error_of(bad).find("bad.yaml:"), std::string::npos) << error_of(bad);
+  EXPECT_NE(error_of(bad).find("complete: missing at the end"), std::string::npos) << error_of(bad);
+  // text with `from` (which it holds) replaced by `to`.
+  const auto edited = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return text.substr(0, at) + to + text.substr(at + from.size());
+  };
+  write_text(bad, edited("0123456789abcdef", "not-a-hash"));
+  EXPECT_NE(error_of(bad).find(":3: parameter_hash: expected 16 hexadecimal digits"),
+            std::string::npos)
+      << error_of(bad);
+  write_text(bad, edited(", 0.5,", ", x,"));
+  EXPECT_NE(error_of(bad).find(":4: values[1]"), std::string::npos) << error_of(bad);
+  write_text(bad, edited("complete", "spare: 1\ncomplete"));
+  EXPECT_NE(error_of(bad).find("spare"), std::string::npos) << error_of(bad);
+}
+
+}  // namespace
+}  // namespace selfsense::daemon
