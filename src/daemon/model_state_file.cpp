@@ -1,6 +1,9 @@
 #include "selfsense/daemon/model_state_file.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -12,6 +15,9 @@
 namespace selfsense::daemon {
 
 void write_model_state(const std::filesystem::path& path, const models::SavedState& state) {
+  for (const double v : state.values) {
+    if (!std::isfinite(v)) throw std::runtime_error(path.string() + ": a state value is not finite");
+  }
   std::string text = "selfsense_model_state: 1\nstructure: ";
   text += models::to_string(state.identity.structure);
   char hash[32];
@@ -51,17 +57,19 @@ models::SavedState read_model_state(const std::filesystem::path& path) {
   if (!parsed) root.fail("structure", "unknown structure '" + structure + "'");
   state.identity.structure = *parsed;
   const std::string hash = root.required<std::string>("parameter_hash");
-  std::size_t used = 0;
-  try {
-    state.identity.parameter_hash = std::stoull(hash, &used, 16);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != hash.size()) {
+  if (hash.size() != 16 || !std::all_of(hash.begin(), hash.end(), [](char c) {
+        return std::isxdigit(static_cast<unsigned char>(c)) != 0;
+      })) {
     root.fail("parameter_hash", "expected 16 hexadecimal digits");
   }
+  state.identity.parameter_hash = std::stoull(hash, nullptr, 16);
   if (!root.has("values")) root.fail("values", "missing");
   root.read_sequence("values", state.values);
+  for (std::size_t i = 0; i < state.values.size(); ++i) {
+    if (!std::isfinite(state.values[i])) {
+      root.fail("values", "value " + std::to_string(i) + " is not finite");
+    }
+  }
   state.identity.state_size = state.values.size();
   root.finish();
   return state;

@@ -21,10 +21,11 @@
 namespace selfsense::daemon {
 
 // Writes beside `path` and renames over it, so a reader never sees half a file. Throws
-// std::runtime_error naming the path.
+// std::runtime_error naming the path (also for a value that is not finite).
 void write_model_state(const std::filesystem::path& path, const models::SavedState& state);
 
-// Throws io::YamlError ("file:line: key: ...") on a malformed or cut file.
+// Throws io::YamlError ("file:line: key: ...") on a malformed or cut file, a hash that is not
+// 16 hexadecimal digits or a value that is not finite.
 [[nodiscard]] models::SavedState read_model_state(const std::filesystem::path& path);
 
 }  // namespace selfsense::daemon
