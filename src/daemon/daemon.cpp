@@ -105,10 +105,7 @@ void Daemon::restore_model_state(models::Reconstruction& model) {
     const models::SavedState saved = read_model_state(path);
     switch (model.restore_state(saved)) {
       case models::RestoreResult::kOk:
-        // Taken once: after a crash the actuator's history is unknown, and a state from before
-        // it would be stale. The next clean stop writes it again.
-        std::filesystem::remove(path, ec);
-        state_at_start_ = "restored";
+        state_at_start_ = "restored";  // the file is removed once the loop runs (run())
         break;
       case models::RestoreResult::kWrongModel:
         state_at_start_ = "not restored: " + path.string() + ": written by another model";
@@ -383,6 +380,12 @@ int Daemon::run() {
   recorder_->start();
   if (config_.recorder.record_at_start) static_cast<void>(recorder_->start_file());
   rt_setup_ = runner_->start();
+  if (state_at_start_ == "restored") {
+    // Taken once: after a crash the actuator's history is unknown, and a state from before it
+    // would be stale. The next clean stop writes it again.
+    std::error_code ec;
+    std::filesystem::remove(config_.model_state, ec);
+  }
   for (const std::string& p : rt_setup_.problems) {
     static_cast<void>(std::fprintf(
         stderr, "selfsensed: real-time set-up: %s%s\n", p.c_str(),
