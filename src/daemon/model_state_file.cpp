@@ -16,7 +16,8 @@ namespace selfsense::daemon {
 
 void write_model_state(const std::filesystem::path& path, const models::SavedState& state) {
   for (const double v : state.values) {
-    if (!std::isfinite(v)) throw std::runtime_error(path.string() + ": a state value is not finite");
+    if (!std::isfinite(v))
+      throw std::runtime_error(path.string() + ": a state value is not finite");
   }
   std::string text = "selfsense_model_state: 1\nstructure: ";
   text += models::to_string(state.identity.structure);

@@ -33,9 +33,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const selfsense::models::SavedState again = selfsense::daemon::read_model_state(out.path());
     require(again.identity == state.identity, "an accepted state keeps its identity");
     require(again.values.size() == state.values.size() &&
-                (state.values.empty() ||
-                 std::memcmp(again.values.data(), state.values.data(),
-                             state.values.size() * sizeof(double)) == 0),
+                (state.values.empty() || std::memcmp(again.values.data(), state.values.data(),
+                                                     state.values.size() * sizeof(double)) == 0),
             "an accepted state keeps its values bit for bit");
   } catch (const std::exception& e) {
     selfsense::fuzz::violated("an accepted state is written and read again", e.what());
