@@ -36,11 +36,8 @@ bool FilterChain::assign(std::span<const BiquadCoefficients> sections, double in
   }
   double x = input;
   for (std::size_t i = 0; i < sections.size(); ++i) {
-    const BiquadCoefficients& now = sections_[i].coefficients();
     const BiquadCoefficients& next = sections[i];
-    const bool same = i < size_ && now.b0 == next.b0 && now.b1 == next.b1 && now.b2 == next.b2 &&
-                      now.a1 == next.a1 && now.a2 == next.a2;
-    if (!same) {
+    if (i >= size_ || !(sections_[i].coefficients() == next)) {
       static_cast<void>(sections_[i].set_coefficients(next));
       sections_[i].reset(x);
     }

@@ -35,12 +35,7 @@ int rounds() {
 
 // Resets (repeated while a start-up cause lasts), arms and starts a sine in position mode.
 void arm_with_wave(RunningDaemon& daemon) {
-  for (int i = 0; i < 100; ++i) {
-    if (daemon.request(R"({"request": "reset"})").value("ok", false)) break;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  const nlohmann::json armed = daemon.request(R"({"request": "arm"})");
-  ASSERT_TRUE(armed.value("ok", false)) << armed.dump();
+  ASSERT_TRUE(daemon.reset_and_arm()) << daemon.status().dump();
   const nlohmann::json wave = daemon.request(
       R"({"request": "wave", "shape": "sine", "amplitude": 3e-4, "offset": 6e-4, "frequency_hz": 5})");
   ASSERT_TRUE(wave.value("ok", false)) << wave.dump();
@@ -48,9 +43,7 @@ void arm_with_wave(RunningDaemon& daemon) {
 
 TEST(DaemonCrash, KillNineWhileRecordingLosesNothingWrittenAndRestartsFaulted) {
   const testing::ScratchDir dir("daemon-crash");
-  testing::write_text(dir.path() / "model.yaml",
-                      testing::read_text(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config" /
-                                         "models" / "sim.yaml"));
+  testing::copy_shipped_model(dir.path());
   std::mt19937 random(1);
   std::uniform_int_distribution<int> armed_ms(20, 700);  // status is published every 10 ms
   const int n = rounds();

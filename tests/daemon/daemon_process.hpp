@@ -16,22 +16,19 @@
 #include <utility>
 #include <vector>
 
+#include "daemon/recording_support.hpp"
 #include "selfsense/daemon/control_client.hpp"
 #include "support/daemon_process.hpp"
 
 namespace selfsense::daemon::testing {
 
-inline std::string read_text(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-inline void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::trunc);
-  out << text;
-  if (!out.flush()) throw std::runtime_error("cannot write " + path.string());
+// A copy of the shipped model (config/models/sim.yaml) as dir/model.yaml, which scratch_config
+// names; returns its path.
+inline std::filesystem::path copy_shipped_model(const std::filesystem::path& dir) {
+  std::filesystem::path model = dir / "model.yaml";
+  write_text(model, read_text(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config" / "models" /
+                              "sim.yaml"));
+  return model;
 }
 
 // config/sim.yaml with the model, socket and telemetry in `dir`, the recordings in `recordings`
@@ -91,6 +88,16 @@ class RunningDaemon final {
     return nlohmann::json::parse(client.exchange(line));
   }
   nlohmann::json status() { return request(R"({"request": "status"})"); }
+  // Reset from the power-up fault (retried while its cause still holds, up to 2 s), then arm;
+  // false if either is refused.
+  bool reset_and_arm() {
+    bool reset = false;
+    for (int i = 0; i < 100 && !reset; ++i) {
+      reset = request(R"({"request": "reset"})").value("ok", false);
+      if (!reset) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return reset && request(R"({"request": "arm"})").value("ok", false);
+  }
 
   void signal(int sig) const { process_.signal(sig); }
   // kill -9; the exit status as test::DaemonProcess::wait gives it (128 + 9).

@@ -22,10 +22,8 @@ bool contains(const std::string& text, const std::string& part) {
 
 TEST(DaemonReload, OnlyAWholeValidFileIsTakenAndAModelOnlyWhileDisarmed) {
   const testing::ScratchDir dir("daemon-reload");
-  const std::filesystem::path model_path = dir.path() / "model.yaml";
+  const std::filesystem::path model_path = testing::copy_shipped_model(dir.path());
   const std::filesystem::path config = dir.path() / "selfsensed.yaml";
-  const std::filesystem::path source = SELFSENSE_SOURCE_DIR;
-  testing::write_text(model_path, testing::read_text(source / "config" / "models" / "sim.yaml"));
   const std::string config_text = testing::scratch_config(dir.path(), {});
   testing::write_text(config, config_text);
   RunningDaemon daemon(config, dir.path() / "control.sock", dir.path() / "selfsensed.log");
@@ -77,9 +75,7 @@ TEST(DaemonReload, OnlyAWholeValidFileIsTakenAndAModelOnlyWhileDisarmed) {
 
   // Both whole, but armed: the model is refused and nothing changes (all or nothing).
   testing::write_text(config, new_gains);
-  for (int i = 0; i < 100 && !daemon.request(R"({"request": "reset"})").value("ok", false); ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  ASSERT_TRUE(daemon.request(R"({"request": "arm"})").value("ok", false));
+  ASSERT_TRUE(daemon.reset_and_arm()) << daemon.status().dump();
   r = reload();
   EXPECT_FALSE(r.value("ok", true)) << r.dump();
   EXPECT_TRUE(contains(r.value("error", ""), "only while disarmed")) << r.dump();
@@ -122,9 +118,7 @@ TEST(DaemonReload, OnlyAWholeValidFileIsTakenAndAModelOnlyWhileDisarmed) {
 TEST(DaemonReload, FiltersAndCommandLimitsChangeWhileArmed) {
   const testing::ScratchDir dir("daemon-reload-tuning");
   const std::filesystem::path config = dir.path() / "selfsensed.yaml";
-  const std::filesystem::path source = SELFSENSE_SOURCE_DIR;
-  testing::write_text(dir.path() / "model.yaml",
-                      testing::read_text(source / "config" / "models" / "sim.yaml"));
+  testing::copy_shipped_model(dir.path());
   const std::string config_text = testing::scratch_config(dir.path(), {});
   testing::write_text(config, config_text);
   RunningDaemon daemon(config, dir.path() / "control.sock", dir.path() / "selfsensed.log");
@@ -132,9 +126,7 @@ TEST(DaemonReload, FiltersAndCommandLimitsChangeWhileArmed) {
   ASSERT_EQ(start["filters"].size(), 2U) << start.dump();
   EXPECT_EQ(start["filters"][0]["frequency_hz"], 2000.0);
   EXPECT_EQ(start["command_v_per_m"][1], 2.0e6);
-  for (int i = 0; i < 100 && !daemon.request(R"({"request": "reset"})").value("ok", false); ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  ASSERT_TRUE(daemon.request(R"({"request": "arm"})").value("ok", false));
+  ASSERT_TRUE(daemon.reset_and_arm()) << daemon.status().dump();
   ASSERT_TRUE(daemon.request(R"({"request": "setpoint", "value": 1.0e-3})").value("ok", false));
   std::this_thread::sleep_for(std::chrono::milliseconds(400));
   const double command = daemon.status()["estimate"]["command"];

@@ -20,18 +20,10 @@ namespace {
 
 using testing::RunningDaemon;
 
-void reset_and_arm(RunningDaemon& daemon) {
-  for (int i = 0; i < 100 && !daemon.request(R"({"request": "reset"})").value("ok", false); ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  ASSERT_TRUE(daemon.request(R"({"request": "arm"})").value("ok", false));
-}
-
 TEST(DaemonState, TheModelsMemoryIsSavedAtAStopAndRestoredAtTheNextStart) {
   const testing::ScratchDir dir("daemon-state");
-  const std::filesystem::path model = dir.path() / "model.yaml";
+  const std::filesystem::path model = testing::copy_shipped_model(dir.path());
   const std::filesystem::path state = dir.path() / "state.yaml";
-  const std::filesystem::path source = SELFSENSE_SOURCE_DIR;
-  testing::write_text(model, testing::read_text(source / "config" / "models" / "sim.yaml"));
   const std::filesystem::path config = dir.path() / "selfsensed.yaml";
   testing::write_text(
       config, testing::scratch_config(
@@ -54,7 +46,7 @@ TEST(DaemonState, TheModelsMemoryIsSavedAtAStopAndRestoredAtTheNextStart) {
     on_request = read_model_state(dump);
     EXPECT_FALSE(std::filesystem::exists(state));  // written at the stop only
     // Through a large excursion, then a stop: the memory at the stop is saved.
-    reset_and_arm(*daemon);
+    ASSERT_TRUE(daemon->reset_and_arm()) << daemon->status().dump();
     ASSERT_TRUE(daemon->request(R"({"request": "setpoint", "value": 1.2e-3})").value("ok", false));
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     EXPECT_EQ(daemon->terminate(), 0);

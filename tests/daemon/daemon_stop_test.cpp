@@ -22,9 +22,7 @@ constexpr int kArmed = 2;          // the recording's state column (contracts.md
 
 TEST(DaemonStop, SigtermWhileArmedRampsToTheSafeOutputThenExitsZero) {
   const testing::ScratchDir dir("daemon-stop");
-  testing::write_text(dir.path() / "model.yaml",
-                      testing::read_text(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config" /
-                                         "models" / "sim.yaml"));
+  testing::copy_shipped_model(dir.path());
   const std::filesystem::path recordings = dir.path() / "recordings";
   const std::filesystem::path config = dir.path() / "selfsensed.yaml";
   testing::write_text(
@@ -32,11 +30,7 @@ TEST(DaemonStop, SigtermWhileArmedRampsToTheSafeOutputThenExitsZero) {
                   dir.path(), {{"record_at_start: false", "record_at_start: true"}}, recordings));
   {
     RunningDaemon daemon(config, dir.path() / "control.sock", dir.path() / "selfsensed.log");
-    for (int i = 0; i < 100; ++i) {
-      if (daemon.request(R"({"request": "reset"})").value("ok", false)) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    ASSERT_TRUE(daemon.request(R"({"request": "arm"})").value("ok", false));
+    ASSERT_TRUE(daemon.reset_and_arm()) << daemon.status().dump();
     ASSERT_TRUE(daemon.request(R"({"request": "setpoint", "value": 8e-4})").value("ok", false));
     std::this_thread::sleep_for(std::chrono::milliseconds(600));
     EXPECT_EQ(daemon.terminate(), 0) << daemon.log();

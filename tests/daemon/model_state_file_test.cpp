@@ -8,7 +8,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 
 #include "daemon/recording_support.hpp"
@@ -18,15 +17,6 @@
 
 namespace selfsense::daemon {
 namespace {
-
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
-}
 
 std::string error_of(const std::filesystem::path& path) {
   try {
@@ -78,10 +68,10 @@ TEST(ModelStateFile, ACutOrMalformedFileIsNamedByLineAndKey) {
   s.values = {1.0, 0.5, 3.0};
   const std::filesystem::path path = dir.path() / "state.yaml";
   write_model_state(path, s);
-  const std::string text = read_text(path);
+  const std::string text = testing::read_text(path);
   const std::filesystem::path bad = dir.path() / "bad.yaml";
 
-  write_text(bad, text.substr(0, text.find("complete")));
+  testing::write_text(bad, text.substr(0, text.find("complete")));
   EXPECT_NE(error_of(bad).find("bad.yaml:"), std::string::npos) << error_of(bad);
   EXPECT_NE(error_of(bad).find("complete: missing at the end"), std::string::npos) << error_of(bad);
   // text with `from` (which it holds) replaced by `to`.
@@ -90,13 +80,13 @@ TEST(ModelStateFile, ACutOrMalformedFileIsNamedByLineAndKey) {
     EXPECT_NE(at, std::string::npos) << from;
     return text.substr(0, at) + to + text.substr(at + from.size());
   };
-  write_text(bad, edited("0123456789abcdef", "not-a-hash"));
+  testing::write_text(bad, edited("0123456789abcdef", "not-a-hash"));
   EXPECT_NE(error_of(bad).find(":3: parameter_hash: expected 16 hexadecimal digits"),
             std::string::npos)
       << error_of(bad);
-  write_text(bad, edited(", 0.5,", ", x,"));
+  testing::write_text(bad, edited(", 0.5,", ", x,"));
   EXPECT_NE(error_of(bad).find(":4: values[1]"), std::string::npos) << error_of(bad);
-  write_text(bad, edited("complete", "spare: 1\ncomplete"));
+  testing::write_text(bad, edited("complete", "spare: 1\ncomplete"));
   EXPECT_NE(error_of(bad).find("spare"), std::string::npos) << error_of(bad);
 }
 

@@ -105,7 +105,6 @@ class Controller final {
   // the limits act from the next step (a command outside them is clamped there, and the PIDs
   // track the clamp as always).
   bool tune(const Tuning& tuning) noexcept;
-  [[nodiscard]] Tuning tuning() const noexcept { return tuning_of(config_); }
 
   [[nodiscard]] ControlMode mode() const noexcept { return mode_; }
   [[nodiscard]] double shaped_setpoint() const noexcept { return shaped_; }
