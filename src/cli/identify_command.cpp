@@ -111,7 +111,10 @@ void run_identify(const IdentifyOptions& opt) {
     throw std::invalid_argument("--holdout or --fit-until leave fewer than 2 samples to fit");
 
   identification::IdentificationOptions sizes = identification::defaults_for(*structure);
-  if (opt.plays >= 0) sizes.plays = static_cast<std::size_t>(opt.plays);
+  if (opt.plays >= 0) {
+    sizes.plays = static_cast<std::size_t>(opt.plays);
+    sizes.choose_plays = false;
+  }
   if (opt.eigenvalues >= 0) sizes.eigenvalues = static_cast<std::size_t>(opt.eigenvalues);
   if (opt.creep_plays >= 0) sizes.creep_plays = static_cast<std::size_t>(opt.creep_plays);
   if (opt.dead_zones >= 0) {
@@ -152,6 +155,10 @@ void run_identify(const IdentifyOptions& opt) {
       "%.2f s\n",
       opt.structure.c_str(), signals.source.c_str(), n, signals.sample_time, split, seconds);
   if (*structure == models::Structure::kPreisachCreep) print_chosen_sizes(model);
+  if (*structure == models::Structure::kStressHysteresis && sizes.choose_plays) {
+    std::printf("sizes chosen on the fitting data: %zu plays\n",
+                model.vectorial->basis.thresholds.size() - 1);
+  }
   print_table(fit, held);
 
   nlohmann::json report = {{"structure", opt.structure},
@@ -220,7 +227,9 @@ void add_identify_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 0.9));
   cmd->add_option("--fit-until", opt->fit_until, "Fit on t < this time [s]; the rest is held out")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--plays", opt->plays, "Play operators (default per structure)")
+  cmd->add_option("--plays", opt->plays,
+                  "Play operators (default per structure; stress-hysteresis chooses 16, 24 or "
+                  "48 on the fitting data unless given)")
       ->check(CLI::Range(0, 512));
   cmd->add_option("--eigenvalues", opt->eigenvalues, "Creep eigenvalues")->check(CLI::Range(0, 32));
   cmd->add_option("--creep-plays", opt->creep_plays, "Creep elements on plays besides r = 0")

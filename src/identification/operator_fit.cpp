@@ -10,6 +10,7 @@
 
 #include "selfsense/identification/nnls.hpp"
 #include "selfsense/identification/regressors.hpp"
+#include "selfsense/identification/remanent_state.hpp"
 #include "selfsense/operators/linear_creep.hpp"
 
 namespace selfsense::identification {
@@ -268,72 +269,6 @@ class Fitter {
   bool offset_;
   std::vector<double> history_{};
 };
-
-std::size_t sweep_length(std::span<const double> x) {
-  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
-  const double margin = 0.02 * (*hi - *lo);
-  bool low = false;
-  bool high = false;
-  for (std::size_t k = 0; k < x.size(); ++k) {
-    low = low || x[k] <= *lo + margin;
-    high = high || x[k] >= *hi - margin;
-    if (low && high) return k + 1;
-  }
-  return x.size();
-}
-
-// Candidate input histories before the first sample x0: demagnetised at x0, or on the major
-// loop (rest at one extreme, then the other) with a last turning point a before x0.
-std::vector<std::vector<double>> history_candidates(std::span<const double> x) {
-  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
-  const double x0 = x.front();
-  std::vector<std::vector<double>> out{{x0}};
-  constexpr int kLevels = 8;
-  for (int i = 0; i <= kLevels; ++i) {
-    const double a = *lo + (*hi - *lo) * i / kLevels;
-    if (a < x0) out.push_back({*lo, *hi, a, x0});  // came down to a, now rising to x0
-    if (a > x0) out.push_back({*hi, *lo, a, x0});  // went up to a, now falling to x0
-  }
-  return out;
-}
-
-// Golden-section search for the last turning point a = h[end - 2] within +-step, on the same
-// side of the first sample x0 = h[end - 1] (the history must still turn there).
-template <typename Residual>
-std::vector<double> refine_turning_point(std::vector<double> h, double step, Residual residual) {
-  const double x0 = h.back();
-  double& turn = h[h.size() - 2];
-  double a = turn - step;
-  double b = turn + step;
-  if (turn < x0) b = std::min(b, x0);
-  if (turn > x0) a = std::max(a, x0);
-  constexpr double kGolden = 0.6180339887498949;
-  const auto at = [&](double v) {
-    turn = v;
-    return residual(h);
-  };
-  double c = b - kGolden * (b - a);
-  double d = a + kGolden * (b - a);
-  double fc = at(c);
-  double fd = at(d);
-  for (int i = 0; i < 8; ++i) {  // brackets the turning point to 2 % of the step
-    if (fc < fd) {
-      b = d;
-      d = c;
-      fd = fc;
-      c = b - kGolden * (b - a);
-      fc = at(c);
-    } else {
-      a = c;
-      c = d;
-      fc = fd;
-      d = a + kGolden * (b - a);
-      fd = at(d);
-    }
-  }
-  turn = fc < fd ? c : d;
-  return h;
-}
 
 void check_signals(const OperatorSignals& s) {
   const std::size_t n = s.input.size();

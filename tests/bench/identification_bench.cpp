@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "selfsense/identification/operator_fit.hpp"
+#include "selfsense/identification/stress_hysteresis_fit.hpp"
 #include "selfsense/operators/typical_stack.hpp"
 
 namespace {
@@ -63,6 +64,18 @@ BENCHMARK(BM_FitOperator1e6)
     ->Args({4, 1})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(2);
+
+// stress-hysteresis with 48 plays: 2 x 49 play columns + T, T^2, offset = 101 columns per
+// side, the remanent-state search and its refinement included (D side only).
+void BM_FitStressHysteresis1e6(benchmark::State& state) {
+  const Recording& r = recording();
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        selfsense::identification::fit_stress_hysteresis(r.e, r.t, r.d, {}, kTs, 48));
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(r.e.size()));
+}
+BENCHMARK(BM_FitStressHysteresis1e6)->Unit(benchmark::kMillisecond)->Iterations(2);
 
 }  // namespace
 

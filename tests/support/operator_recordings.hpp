@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "selfsense/models/reconstructor.hpp"
+#include "selfsense/models/stress_hysteresis.hpp"
 
 namespace selfsense::test {
 
@@ -158,19 +159,8 @@ inline void validation_excitation(std::size_t n, double ts, std::uint64_t seed,
   }
 }
 
-// Runs the generator over a field and load, adds the measurement noise.
-inline OperatorRecording record_generator(const models::TransducerModel& truth,
-                                          std::vector<double> e, std::vector<double> t,
-                                          double noise_share, std::uint64_t seed) {
-  OperatorRecording r;
-  models::ForwardModel plant(truth);
-  for (std::size_t k = 0; k < e.size(); ++k) {
-    const models::ForwardModel::Output y = plant.step(e[k], t[k]);
-    r.d.push_back(y.sensed);
-    r.s_true.push_back(y.strain);
-  }
-  r.e = std::move(e);
-  r.t_true = std::move(t);
+// Measured S and T: the true ones plus Gaussian noise of noise_share of their range.
+inline void add_noise(OperatorRecording& r, double noise_share, std::uint64_t seed) {
   const auto range = [](const std::vector<double>& v) {
     const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
     return *hi - *lo;
@@ -183,7 +173,68 @@ inline OperatorRecording record_generator(const models::TransducerModel& truth,
     r.s.push_back(r.s_true[k] + s_noise * n01(rng));
     r.t.push_back(r.t_true[k] + t_noise * n01(rng));
   }
+}
+
+// Runs a generator (step(E, T) -> sensed D and strain S) over a field and load, adds the
+// measurement noise.
+template <typename Generator>
+OperatorRecording record(Generator& plant, std::vector<double> e, std::vector<double> t,
+                         double noise_share, std::uint64_t seed) {
+  OperatorRecording r;
+  for (std::size_t k = 0; k < e.size(); ++k) {
+    const auto y = plant.step(e[k], t[k]);
+    r.d.push_back(y.sensed);
+    r.s_true.push_back(y.strain);
+  }
+  r.e = std::move(e);
+  r.t_true = std::move(t);
+  add_noise(r, noise_share, seed);
   return r;
+}
+
+inline OperatorRecording record_generator(const models::TransducerModel& truth,
+                                          std::vector<double> e, std::vector<double> t,
+                                          double noise_share, std::uint64_t seed) {
+  models::ForwardModel plant(truth);
+  return record(plant, std::move(e), std::move(t), noise_share, seed);
+}
+
+// Loop size that changes with stress, on the same power-law play grid, no creep, no asymmetry:
+//   D = W0 . q(E) + T (W1 . q(E)) + d T,   S likewise with sE,
+// W0 the PI weights of generator_side, W1 = -loop_change / 1e7 Pa times its play weights (the
+// linear term keeps its slope): under 10 MPa of compression the loops are `loop_change`
+// larger. The stress-dependent class (models/stress_hysteresis.hpp) on other thresholds.
+inline models::StressHysteresisModel stress_generator(double ts, double loop_change) {
+  models::StressHysteresisModel m;
+  m.sample_time = ts;
+  m.history = {0.0, kFieldMax, kFieldMin, 0.0};
+  const auto side = [&](double full_scale, double share, double coupling) {
+    const operators::HysteresisCreep::Params p = generator_side(full_scale, share, 0.0, 0.0);
+    models::StressHysteresisSide out;
+    out.base.push_back(p.hysteresis.linear_weight);
+    out.stress.push_back(0.0);
+    for (const double w : p.hysteresis.weights) {
+      out.base.push_back(w);
+      out.stress.push_back(-loop_change / 1e7 * w);
+    }
+    out.linear = coupling;
+    return out;
+  };
+  m.basis.thresholds.push_back(0.0);
+  for (const double r : generator_side(1.0, 0.1, 0.0, 0.0).hysteresis.thresholds)
+    m.basis.thresholds.push_back(r);
+  m.sensor = side(0.1, 0.15, kCouplingD);
+  m.actuator = side(1.5e-3, 0.12, kCouplingS);
+  m.stress_min = -3e7;
+  m.stress_max = 1e7;
+  return m;
+}
+
+inline OperatorRecording record_stress_generator(const models::StressHysteresisModel& truth,
+                                                 std::vector<double> e, std::vector<double> t,
+                                                 double noise_share, std::uint64_t seed) {
+  models::StressHysteresisForward plant(truth);
+  return record(plant, std::move(e), std::move(t), noise_share, seed);
 }
 
 }  // namespace selfsense::test

@@ -29,8 +29,13 @@ struct IdentificationOptions {
   // dead_zones, then bias_levels among kBiasLevelCandidates.
   bool choose_bias_levels{false};
   bool choose_dead_zones{false};
+  // stress-hysteresis chooses its play count among kStressPlayCandidates on the fitting data
+  // alone: the reconstruction error (T_hat, and S_hat with a strain channel) on the last
+  // quarter of a fit on the first three quarters.
+  bool choose_plays{false};
 };
 inline constexpr std::array<std::size_t, 3> kBiasLevelCandidates{0, 1, 3};
+inline constexpr std::array<std::size_t, 3> kStressPlayCandidates{16, 24, 48};
 [[nodiscard]] IdentificationOptions defaults_for(Structure s) noexcept;
 
 // Recorded signals in field quantities. drive is E (field drive) or D (charge drive), sensed
