@@ -387,6 +387,58 @@ std::vector<double> estimate_history(const OperatorSignals& signals, const Opera
   return history;
 }
 
+// Candidate starts for best_start: `first` (when given, it wins ties), the picks of the
+// searches that rank the candidates within the recorded range with cheap proxies of the basis
+// (the plays alone, or with the creep lags of the linear term; no hinges), the demagnetised
+// start and the starts from beyond the recorded range. On the simulated transducer, which
+// starts from negative saturation, the proxies picked a start inside the range (a different
+// one for 24 and 48 plays, so 48 fitted worse) and the new recording's T_hat was 1.03 %; the
+// whole basis picks a turning point below the range: 0.34 % (docs/identification.md).
+std::vector<std::vector<double>> start_finalists(const OperatorSignals& signals,
+                                                 const OperatorBasis& basis, double weight_floor,
+                                                 bool offset, const std::vector<double>& first) {
+  std::vector<std::vector<double>> finalists;
+  if (!first.empty()) finalists.push_back(first);
+  finalists.push_back(estimate_history(signals, basis, weight_floor, offset, true));
+  if (basis.creep() > 0)
+    finalists.push_back(estimate_history(signals, basis, weight_floor, offset, false));
+  finalists.push_back({signals.input.front()});
+  for (std::vector<double>& c : outside_candidates(signals.input))
+    finalists.push_back(std::move(c));
+  return finalists;
+}
+
+// The finalist whose linear stage (the whole basis, S = identity) fits the whole recording
+// best, its last turning point then refined by the same score. Rows after the first sweep are
+// the same for every history (the plays are wiped; the creep lags still remember, which the
+// shared rows ignore), so they are accumulated once.
+std::vector<double> best_start(const Fitter& fitter, std::span<const double> x,
+                               const std::vector<std::vector<double>>& finalists) {
+  const std::size_t n = x.size();
+  const std::size_t sweep = std::min(n, sweep_length(x));
+  const GramAccumulator shared = fitter.linear_gram(finalists.front(), sweep, n);
+  const auto residual = [&](const std::vector<double>& h) {
+    GramAccumulator acc = fitter.linear_gram(h, 0, sweep);
+    acc.add(shared);
+    return fitter.solve_linear(acc).rss;
+  };
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<double> chosen = finalists.front();
+  for (const std::vector<double>& h : finalists) {
+    const double rss = residual(h);
+    if (rss < best) {
+      best = rss;
+      chosen = h;
+    }
+  }
+  if (chosen.size() > 1) {
+    const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+    std::vector<double> refined = refine_turning_point(chosen, (*hi - *lo) / 8.0, residual);
+    if (residual(refined) < best) chosen = std::move(refined);
+  }
+  return chosen;
+}
+
 // Linear stage, then (with dead zones) the equation error for S and output-error passes that
 // refit S and the operator in turn, keeping whichever fit explains the data best.
 Fit fit_with_history(Fitter& fitter, const std::vector<double>& history,
@@ -438,24 +490,8 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
   const bool search = structure.estimate_history && structure.plays > 0;
   std::vector<double> history{signals.input.front()};
   if (search) {
-    history = estimate_history(signals, basis, weight_floor, structure.fit_offset, true);
-    if (basis.creep() > 0) {
-      // Scored with the plays alone, the early creep transient is blamed on the plays and the
-      // wrong start can win (2x the least-squares error on a new recording); scored with the
-      // linear creep lags alone, the plant's actuator side got a start with 4 % more residual.
-      // Both are proxies: when they disagree, the whole basis decides on the first part of the
-      // data (where the start shows), at a fraction of the cost of a second full fit.
-      std::vector<double> plays_only =
-          estimate_history(signals, basis, weight_floor, structure.fit_offset, false);
-      if (plays_only != history) {
-        const std::size_t head =
-            std::min(n, std::max<std::size_t>(2 * sweep_length(signals.input), 2000));
-        const auto head_rss = [&](const std::vector<double>& h) {
-          return fitter.solve_linear(fitter.linear_gram(h, 0, head)).rss;
-        };
-        if (head_rss(plays_only) < head_rss(history)) history = std::move(plays_only);
-      }
-    }
+    history = best_start(fitter, signals.input,
+                         start_finalists(signals, basis, weight_floor, structure.fit_offset, {}));
   }
   Fit fit = fit_with_history(fitter, history, structure, n);
   if (basis.hinges() > 0 && structure.dead_zones > 0) {
@@ -484,7 +520,9 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
     // operator is linear, and keep the better fit.
     const std::vector<double> v = inner_output(signals, fit);
     const OperatorSignals inner{signals.input, {}, v, signals.sample_time};
-    std::vector<double> second = estimate_history(inner, basis, weight_floor, true, true);
+    const Fitter inner_fitter(inner, basis, weight_floor, true);
+    std::vector<double> second = best_start(
+        inner_fitter, signals.input, start_finalists(inner, basis, weight_floor, true, history));
     if (second != history) {
       Fit refit = fit_with_history(fitter, second, structure, n);
       if (refit.rss < fit.rss) {

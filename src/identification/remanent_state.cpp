@@ -67,4 +67,19 @@ std::vector<double> refine_turning_point(
   return h;
 }
 
+std::vector<std::vector<double>> outside_candidates(std::span<const double> x) {
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  const double x0 = x.front();
+  const double range = *hi - *lo;
+  std::vector<std::vector<double>> out;
+  constexpr int kLevels = 8;
+  for (int j = 1; j <= kLevels; ++j) {
+    const double below = *lo - range * j / kLevels;
+    const double above = *hi + range * j / kLevels;
+    out.push_back({*lo, *hi, below, x0});  // swept the range, came down below it, now rising
+    out.push_back({*hi, *lo, above, x0});  // swept the range, went up above it, now falling
+  }
+  return out;
+}
+
 }  // namespace selfsense::identification

@@ -144,8 +144,8 @@ TEST(PlantAccuracy, SelfSensingOnAHeldOutRecordingMeetsTheGoals) {
       100 * lin.strain.nrmse, 100 * lin.stress.nrmse);
   RecordProperty("S_hat_nrmse", std::to_string(hc.strain.nrmse));
   RecordProperty("T_hat_nrmse", std::to_string(hc.stress.nrmse));
-  // Issue 4 goals: S_hat nrmse <= 0.3 %, max <= 1.5 %; T_hat nrmse <= 1.5 %. Measured 0.195 %,
-  // 1.24 % and 0.665 %: the bounds below are about 1.3x of that, to catch a regression.
+  // Issue 4 goals: S_hat nrmse <= 0.3 %, max <= 1.5 %; T_hat nrmse <= 1.5 %. Measured 0.188 %,
+  // 1.23 % and 0.653 %: the bounds below are about 1.3x of that, to catch a regression.
   EXPECT_LE(hc.strain.nrmse, 0.0025);
   EXPECT_LE(hc.strain.max, 0.015);
   EXPECT_LE(hc.stress.nrmse, 0.0085);
@@ -157,8 +157,9 @@ TEST(PlantAccuracy, SelfSensingOnAHeldOutRecordingMeetsTheGoals) {
 // Excitation the fit never saw, the worst of three drawn validations, for the structure whose
 // hinges per play were chosen on the fitting recording alone (transducer_fit.hpp), against
 // hysteresis-creep identified on the same recording. Issue 7's goal (S_hat <= 0.3 % RMS and
-// 1.5 % max, T_hat <= 1.5 %) is open: met on these three, not on the main job's validation
-// (docs/results.md). Asserted: the measured worst figures with a margin, and the improvement.
+// 1.5 % max, T_hat <= 1.5 %) is met on these three and on the main job's validation
+// (docs/results.md). Asserted: the measured worst figures (0.216 %, 0.487 %, 0.897 %) with a
+// margin of about 1.3x, and the improvement (0.56x and 0.61x of hysteresis-creep).
 TEST(PlantAccuracy, PreisachClassImprovesSelfSensingOnNewExcitation) {
   Figures worst_pc{};
   Figures worst_hc{};
@@ -183,11 +184,11 @@ TEST(PlantAccuracy, PreisachClassImprovesSelfSensingOnNewExcitation) {
   }
   RecordProperty("worst_S_hat_nrmse", std::to_string(worst_pc.strain.nrmse));
   RecordProperty("worst_T_hat_nrmse", std::to_string(worst_pc.stress.nrmse));
-  EXPECT_LE(worst_pc.strain.nrmse, 0.0032);
-  EXPECT_LE(worst_pc.strain.max, 0.015);
-  EXPECT_LE(worst_pc.stress.nrmse, 0.012);
-  EXPECT_LE(worst_pc.strain.nrmse, 0.8 * worst_hc.strain.nrmse);
-  EXPECT_LE(worst_pc.stress.nrmse, 0.8 * worst_hc.stress.nrmse);
+  EXPECT_LE(worst_pc.strain.nrmse, 0.0028);
+  EXPECT_LE(worst_pc.strain.max, 0.0065);
+  EXPECT_LE(worst_pc.stress.nrmse, 0.0117);
+  EXPECT_LE(worst_pc.strain.nrmse, 0.75 * worst_hc.strain.nrmse);
+  EXPECT_LE(worst_pc.stress.nrmse, 0.75 * worst_hc.stress.nrmse);
 }
 
 // Open-loop tracking of a strain trajectory that was not in the identification data, with the
@@ -221,7 +222,7 @@ TEST(PlantAccuracy, InverseCompensationTracksAHeldOutTrajectory) {
   RecordProperty("uncompensated_nrmse", std::to_string(uncompensated));
   std::printf("tracking nrmse: compensated %.3f %%, linear inverse %.3f %%\n", 100 * compensated,
               100 * uncompensated);
-  // Measured 0.424 % against 6.80 % for the linear inverse.
+  // Measured 0.439 % against 6.80 % for the linear inverse.
   EXPECT_LT(compensated, 0.0055);
   EXPECT_LT(compensated, 0.3 * uncompensated);
 }

@@ -21,6 +21,13 @@ namespace selfsense::identification {
 // 9 levels over x's range.
 [[nodiscard]] std::vector<std::vector<double>> history_candidates(std::span<const double> x);
 
+// Candidates with the last turning point a outside x's range, a grid of 8 levels up to a whole
+// range below the minimum (rising to x0) and above the maximum (falling to x0). An actuator
+// arrives at a recording from wherever it was driven or poled before (the simulated transducer
+// from negative saturation); with plays up to half the range, a turning point a whole range
+// away is as good as saturation.
+[[nodiscard]] std::vector<std::vector<double>> outside_candidates(std::span<const double> x);
+
 // Golden-section search for the last turning point a = h[end - 2] within +-step, on the same
 // side of the first sample x0 = h[end - 1] (the history must still turn there); brackets it
 // to 2 % of the step. residual: the score of a history (smaller is better).
