@@ -21,8 +21,11 @@
 //     step for H + K, g, offset (exact on each linear piece of S), each a bounded least-squares
 //     problem again; the fit with the smallest output error is kept;
 //  3. the remanent state before the first sample is chosen among candidate input histories
-//     (a previous extremum at a grid of levels) by the residual on the first part of the data,
-//     with dead zones a second time through the fitted S^-1 (docs/identification.md).
+//     (remanent_state.hpp: a last turning point on a grid inside and beyond the recorded
+//     range, and the demagnetised start): cheap proxies of the basis rank those inside the
+//     range, then the whole basis decides between their picks and the rest over the whole
+//     recording and refines the winner's turning point; with dead zones a second time through
+//     the fitted S^-1 (docs/identification.md).
 // Thresholds follow from the input's range, creep eigenvalues from the sample time and the
 // duration. Not real-time code.
 #pragma once
