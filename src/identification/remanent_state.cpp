@@ -72,10 +72,9 @@ std::vector<std::vector<double>> outside_candidates(std::span<const double> x) {
   const double x0 = x.front();
   const double range = *hi - *lo;
   std::vector<std::vector<double>> out;
-  constexpr int kLevels = 8;
-  for (int j = 1; j <= kLevels; ++j) {
-    const double below = *lo - range * j / kLevels;
-    const double above = *hi + range * j / kLevels;
+  for (const double distance : {0.125, 0.25, 0.5, 1.0}) {
+    const double below = *lo - range * distance;
+    const double above = *hi + range * distance;
     out.push_back({*lo, *hi, below, x0});  // swept the range, came down below it, now rising
     out.push_back({*hi, *lo, above, x0});  // swept the range, went up above it, now falling
   }

@@ -21,8 +21,9 @@ namespace selfsense::identification {
 // 9 levels over x's range.
 [[nodiscard]] std::vector<std::vector<double>> history_candidates(std::span<const double> x);
 
-// Candidates with the last turning point a outside x's range, a grid of 8 levels up to a whole
-// range below the minimum (rising to x0) and above the maximum (falling to x0). An actuator
+// Candidates with the last turning point a outside x's range: 1/8, 1/4, 1/2 and a whole range
+// below the minimum (rising to x0) and above the maximum (falling to x0); a refinement of
+// +-range/8 around the nearest covers the first range/2 without gaps. An actuator
 // arrives at a recording from wherever it was driven or poled before (the simulated transducer
 // from negative saturation); with plays up to half the range, a turning point a whole range
 // away is as good as saturation.
