@@ -393,7 +393,7 @@ std::vector<double> estimate_history(const OperatorSignals& signals, const Opera
 // start and the starts from beyond the recorded range. On the simulated transducer, which
 // starts from negative saturation, the proxies picked a start inside the range (a different
 // one for 24 and 48 plays, so 48 fitted worse) and the new recording's T_hat was 1.03 %; the
-// whole basis picks a turning point below the range: 0.34 % (docs/identification.md).
+// whole basis picks a turning point below the range: 0.42 % (docs/identification.md).
 std::vector<std::vector<double>> start_finalists(const OperatorSignals& signals,
                                                  const OperatorBasis& basis, double weight_floor,
                                                  bool offset, const std::vector<double>& first) {
