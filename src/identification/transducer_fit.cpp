@@ -96,7 +96,7 @@ OperatorModel fit_side(const OperatorSignals& s, OperatorStructure structure,
 // strain is recorded; without a sensed channel the strain's output error. The grid of n plays
 // is not nested in that of m > n, and a denser grid matters (a generator off the grid: T_hat
 // 3.8 / 2.4 / 0.11 % on new data with 16 / 24 / 48 plays, docs/identification.md).
-std::size_t choose_stress_plays(const TransducerSignals& s) {
+std::size_t choose_stress_plays(const TransducerSignals& s, std::size_t fallback) {
   const std::size_t n = s.drive.size();
   const std::size_t split = n - n / 4;
   const auto head = [split](std::span<const double> v) { return v.empty() ? v : v.first(split); };
@@ -105,6 +105,11 @@ std::size_t choose_stress_plays(const TransducerSignals& s) {
   double best_score = std::numeric_limits<double>::infinity();
   std::vector<double> t_hat(n);
   std::vector<double> s_hat(n);
+  const auto varies = [](std::span<const double> v) {
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    return *hi > *lo;
+  };
+  if (!varies(head(s.stress)) || !varies(head(s.drive))) return fallback;  // nothing to fit
   for (const std::size_t plays : kStressPlayCandidates) {
     const models::StressHysteresisModel m = fit_stress_hysteresis(
         head(s.drive), head(s.stress), head(s.sensed), head(s.strain), s.sample_time, plays);
@@ -178,8 +183,9 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
     if (signals.stress.empty()) {
       throw std::invalid_argument("identify: stress-hysteresis needs a stress channel (T or F)");
     }
-    const std::size_t plays =
-        options.choose_plays && n >= 8 ? choose_stress_plays(signals) : options.plays;
+    const std::size_t plays = options.choose_plays && n >= 8
+                                  ? choose_stress_plays(signals, options.plays)
+                                  : options.plays;
     model.vectorial = fit_stress_hysteresis(signals.drive, signals.stress, signals.sensed,
                                             signals.strain, signals.sample_time, plays);
     return model;
