@@ -158,7 +158,7 @@ IdentificationOptions defaults_for(Structure s) noexcept {
     case Structure::kPreisachCreep:
       return {24, 6, 2, 8, true, 0.0, 0.0, 0, true, true};
     case Structure::kStressHysteresis:
-      return {16, 0, 0, 0, false, 0.0, 0.0, 0, false, false, true};
+      return {16, 0, 0, 0, true, 0.0, 0.0, 0, false, false, true};  // always estimates its start
   }
   return {};
 }
