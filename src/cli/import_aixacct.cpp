@@ -207,6 +207,9 @@ AixacctImport import_aixacct(const std::filesystem::path& path, const AixacctOpt
     std::string comment = "aixacct " + key;
     comment += ": ";
     comment += value;
+    // A carriage return inside a header line (lines split on '\n' only keep it) would break the
+    // comment over two lines of the recording, which the writer refuses.
+    std::replace(comment.begin(), comment.end(), '\r', ' ');
     rec.comments.push_back(std::move(comment));
   }
   rec.set_column("t", raw.t);
