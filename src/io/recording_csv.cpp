@@ -270,7 +270,10 @@ Recording read_recording_csv(const std::filesystem::path& path, const ReadOption
   const std::string_view data = file_text.text();
   const char* pos = data.data();
   const char* const end = data.data() + data.size();
-  if (data.starts_with(kUtf8Bom)) pos += kUtf8Bom.size();
+  // Every leading byte-order mark (a file saved twice by a tool that adds one): a second one
+  // kept in the first column's name would not survive a write and a read.
+  while (std::string_view(pos, static_cast<std::size_t>(end - pos)).starts_with(kUtf8Bom))
+    pos += kUtf8Bom.size();
   if (rest_is_blank(pos, end)) throw RecordingError(file + ": empty file: no header row");
 
   Recording recording;
