@@ -24,22 +24,12 @@ constexpr std::size_t kFitSamples = 60000;
 constexpr std::size_t kValidationSamples = 40000;
 constexpr double kNoise = 5e-4;  // 0.05 % of range on S and T
 
-struct Recordings {
-  test::OperatorRecording fit, validation;
-};
+using Recordings = test::RecordingPair;
 
 Recordings recordings(bool creep, double asymmetry) {
   const models::TransducerModel truth = test::generator_transducer(kTs, creep, asymmetry);
-  Recordings r;
-  std::vector<double> e;
-  std::vector<double> t;
-  test::identification_excitation(kFitSamples, kTs, 11, e, t);
-  r.fit = test::record_generator(truth, e, t, kNoise, 12);
-  e.clear();
-  t.clear();
-  test::validation_excitation(kValidationSamples, kTs, 21, e, t);
-  r.validation = test::record_generator(truth, e, t, kNoise, 22);
-  return r;
+  return test::record_pair([&truth] { return models::ForwardModel(truth); }, kFitSamples,
+                           kValidationSamples, kTs, kNoise);
 }
 
 // nrmse (fraction of range) of the forward model (D, S from E and the measured T) and of the

@@ -23,23 +23,11 @@ constexpr std::size_t kFitSamples = 60000;
 constexpr std::size_t kValidationSamples = 40000;
 constexpr double kNoise = 5e-4;
 
-struct Recordings {
-  test::OperatorRecording fit, validation;
-};
-
-const Recordings& recordings() {
-  static const Recordings r = [] {
+const test::RecordingPair& recordings() {
+  static const test::RecordingPair r = [] {
     const models::StressHysteresisModel truth = test::stress_generator(kTs, 0.3);
-    Recordings out;
-    std::vector<double> e;
-    std::vector<double> t;
-    test::identification_excitation(kFitSamples, kTs, 11, e, t);
-    out.fit = test::record_stress_generator(truth, e, t, kNoise, 12);
-    e.clear();
-    t.clear();
-    test::validation_excitation(kValidationSamples, kTs, 21, e, t);
-    out.validation = test::record_stress_generator(truth, e, t, kNoise, 22);
-    return out;
+    return test::record_pair([&truth] { return models::StressHysteresisForward(truth); },
+                             kFitSamples, kValidationSamples, kTs, kNoise);
   }();
   return r;
 }
@@ -127,7 +115,7 @@ void print(const char* what, const Figures& f) {
 // fit and 23x on new data; with the start of the affine-in-T search alone, 1.4x and 3x (the
 // turning point 0.7 % of the field range off).
 TEST(StressHysteresisOptimum, ReachesTheLeastSquaresOptimumOfEachBasis) {
-  const Recordings& r = recordings();
+  const test::RecordingPair& r = recordings();
   const TransducerSignals fit{r.fit.e, r.fit.d, r.fit.t, r.fit.s, kTs};
   Figures previous{1.0, 1.0, 0};
   for (const std::size_t plays : kStressPlayCandidates) {
@@ -162,7 +150,7 @@ TEST(StressHysteresisOptimum, ReachesTheLeastSquaresOptimumOfEachBasis) {
 // hysteresis-creep model cannot follow the loop size (measured 0.111 / 0.083 % against
 // 4.90 / 3.25 %).
 TEST(StressHysteresisOptimum, ChosenSizeReachesTheNoiseFloorOnANewRecording) {
-  const Recordings& r = recordings();
+  const test::RecordingPair& r = recordings();
   const TransducerSignals fit{r.fit.e, r.fit.d, r.fit.t, r.fit.s, kTs};
   const models::TransducerModel lib = identify(fit, models::Structure::kStressHysteresis,
                                                defaults_for(models::Structure::kStressHysteresis));

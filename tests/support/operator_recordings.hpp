@@ -192,13 +192,6 @@ OperatorRecording record(Generator& plant, std::vector<double> e, std::vector<do
   return r;
 }
 
-inline OperatorRecording record_generator(const models::TransducerModel& truth,
-                                          std::vector<double> e, std::vector<double> t,
-                                          double noise_share, std::uint64_t seed) {
-  models::ForwardModel plant(truth);
-  return record(plant, std::move(e), std::move(t), noise_share, seed);
-}
-
 // Loop size that changes with stress, on the same power-law play grid, no creep, no asymmetry:
 //   D = W0 . q(E) + T (W1 . q(E)) + d T,   S likewise with sE,
 // W0 the PI weights of generator_side, W1 = -loop_change / 1e7 Pa times its play weights (the
@@ -230,11 +223,28 @@ inline models::StressHysteresisModel stress_generator(double ts, double loop_cha
   return m;
 }
 
-inline OperatorRecording record_stress_generator(const models::StressHysteresisModel& truth,
-                                                 std::vector<double> e, std::vector<double> t,
-                                                 double noise_share, std::uint64_t seed) {
-  models::StressHysteresisForward plant(truth);
-  return record(plant, std::move(e), std::move(t), noise_share, seed);
+// The fitting recording (identification_excitation) and one generated anew
+// (validation_excitation) of a generator: make() returns a fresh one for each, so both start
+// from its history. Fixed seeds.
+struct RecordingPair {
+  OperatorRecording fit, validation;
+};
+
+template <typename MakeGenerator>
+RecordingPair record_pair(MakeGenerator make, std::size_t fit_samples,
+                          std::size_t validation_samples, double ts, double noise_share) {
+  RecordingPair out;
+  std::vector<double> e;
+  std::vector<double> t;
+  identification_excitation(fit_samples, ts, 11, e, t);
+  auto fit_plant = make();
+  out.fit = record(fit_plant, std::move(e), std::move(t), noise_share, 12);
+  e.clear();
+  t.clear();
+  validation_excitation(validation_samples, ts, 21, e, t);
+  auto validation_plant = make();
+  out.validation = record(validation_plant, std::move(e), std::move(t), noise_share, 22);
+  return out;
 }
 
 }  // namespace selfsense::test
