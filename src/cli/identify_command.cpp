@@ -239,7 +239,7 @@ void add_identify_command(CLI::App& app) {
                   "given)")
       ->check(CLI::Range(0, 64));
   cmd->add_option("--bias-levels", opt->bias_levels,
-                  "Hinges per play (0: PI operator; preisach-creep chooses 0, 1 or 3 on the "
+                  "Hinges per play (0: PI operator; preisach-creep chooses 0, 1, 3 or 7 on the "
                   "fitting data unless given)")
       ->check(CLI::Range(0, 32));
   cmd->add_option("--fastest-eigenvalue", opt->fastest, "Fastest creep eigenvalue [1/s]")

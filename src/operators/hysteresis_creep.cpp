@@ -123,7 +123,10 @@ void HysteresisCreep::apply(std::span<const double> x, std::span<double> y) noex
 double HysteresisCreep::input_for(double y) noexcept {
   const double carry = kernels::dot(carry_weights_, lags());
   const double target = shape_inverse_.evaluate(y) - carry;
-  if (!hinge_rows_.empty()) return solve_inner(target);
+  if (!hinge_rows_.empty()) {
+    last_root_ = solve_inner(target, std::isfinite(last_root_) ? last_root_ : state_[0]);
+    return last_root_;
+  }
   PrandtlIshlinskii::inverse_state(effective_weights_, plays(), scratch_);
   kernels::play_bank_step(target, inverse_thresholds_, scratch_);
   return kernels::dot(inverse_weights_, scratch_);
@@ -131,46 +134,60 @@ double HysteresisCreep::input_for(double y) noexcept {
 
 // sum_i (w_i + b_i) p_i(x) + hinges(p(x)) with p_i(x) = clamp(p_i, x - r_i, x + r_i): the
 // creep-free part of this sample's H + K (the carry is the rest). A play moves with x (slope
-// 1) where the clamp binds, else it holds.
-double HysteresisCreep::trial_inner(double x, double* slope) const noexcept {
+// 1) where the clamp binds, else it holds; a hinge adds its slope while its play is above the
+// level. The function is linear between kinks (a play's at p_i -+ r_i, a hinge's where its
+// play's output crosses the level: b + r_i above p_i, b - r_i below), so the slopes are taken
+// on each side of x (x sits on a kink of every moving play: there the sides differ) up to the
+// nearest kinks below and above.
+HysteresisCreep::Trial HysteresisCreep::trial_inner(double x) const noexcept {
   const std::span<const double> p = std::span<const double>(state_).first(play_count());
-  const auto moved = [&](std::size_t i) {
-    return std::min(std::max(p[i], x - thresholds_[i]), x + thresholds_[i]);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Trial t{0.0, 0.0, 0.0, -kInf, kInf};
+  const auto kink = [&](double at) {
+    if (at > x) t.above = std::min(t.above, at);
+    if (at < x) t.below = std::max(t.below, at);
   };
-  const auto moving = [&](std::size_t i, double now) {
-    return now != p[i] || thresholds_[i] == 0.0;
+  // Does the play of row i move with x just below x / just above x?
+  const auto moves_down = [&](std::size_t i) {
+    return x <= p[i] - thresholds_[i] || x > p[i] + thresholds_[i];
   };
-  double value = 0.0;
-  double rate = 0.0;
+  const auto moves_up = [&](std::size_t i) {
+    return x >= p[i] + thresholds_[i] || x < p[i] - thresholds_[i];
+  };
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const double now = moved(i);
-    value += effective_weights_[i] * now;
-    if (moving(i, now)) rate += effective_weights_[i];
+    const double r = thresholds_[i];
+    t.value += effective_weights_[i] * std::min(std::max(p[i], x - r), x + r);
+    if (moves_down(i)) t.slope_down += effective_weights_[i];
+    if (moves_up(i)) t.slope_up += effective_weights_[i];
+    if (r > 0.0) {
+      kink(p[i] - r);
+      kink(p[i] + r);
+    }
   }
   const PlayHinges& g = params_.hinges;
   for (std::size_t h = 0; h < hinge_rows_.size(); ++h) {
     const std::size_t i = hinge_rows_[h];
-    const double now = moved(i);
-    if (now > g.levels[h]) {
-      value += g.weights[h] * (now - g.levels[h]);
-      if (moving(i, now)) rate += g.weights[h];
-    }
+    const double r = thresholds_[i];
+    const double level = g.levels[h];
+    const double now = std::min(std::max(p[i], x - r), x + r);
+    if (now > level) t.value += g.weights[h] * (now - level);
+    if (now > level && moves_down(i)) t.slope_down += g.weights[h];
+    if (now >= level && moves_up(i)) t.slope_up += g.weights[h];
+    kink(level >= p[i] ? level + r : level - r);
   }
-  *slope = rate;
-  return value;
+  return t;
 }
 
-double HysteresisCreep::solve_inner(double target) const noexcept {
+double HysteresisCreep::solve_inner(double target, double start) const noexcept {
   if (!std::isfinite(target)) return target;
-  // Start where the input is now: the answer is near it for any sample-to-sample change.
-  double x = state_[0];
+  double x = start;
   double lo = -std::numeric_limits<double>::infinity();
   double hi = std::numeric_limits<double>::infinity();
   double step = scale_;
   constexpr int kIterations = 100;
   for (int it = 0; it < kIterations; ++it) {
-    double slope = 0.0;
-    const double miss = trial_inner(x, &slope) - target;
+    const Trial trial = trial_inner(x);
+    const double miss = trial.value - target;
     if (miss == 0.0) return x;
     if (miss < 0.0) {
       lo = x;
@@ -179,8 +196,11 @@ double HysteresisCreep::solve_inner(double target) const noexcept {
     }
     const bool bracketed = std::isfinite(lo) && std::isfinite(hi);
     if (bracketed && hi - lo <= 1e-12 * std::max(std::abs(lo), std::abs(hi))) break;
+    // Newton with the slope on the root's side; inside the piece the function is that line,
+    // so a step that stays in it lands on the root (most samples need this one evaluation).
+    const double slope = miss < 0.0 ? trial.slope_up : trial.slope_down;
     double next = slope > 0.0 ? x - miss / slope : std::numeric_limits<double>::quiet_NaN();
-    // On the root's linear piece Newton lands on the root; what is left is rounding.
+    if (next >= trial.below && next <= trial.above) return next;
     if (std::abs(next - x) <= 1e-12 * std::max(std::abs(x), scale_)) return next;
     if (!(next > lo && next < hi)) {
       if (bracketed) {
@@ -216,10 +236,12 @@ double HysteresisCreep::output() const noexcept {
 
 void HysteresisCreep::set_state(std::span<const double> state) noexcept {
   assert(state.size() == state_.size());
+  last_root_ = std::numeric_limits<double>::quiet_NaN();
   std::copy(state.begin(), state.end(), state_.begin());
 }
 
 void HysteresisCreep::reset(double x) noexcept {
+  last_root_ = std::numeric_limits<double>::quiet_NaN();
   std::fill(state_.begin(), state_.end(), x);
 }
 

@@ -124,6 +124,7 @@ BENCHMARK(BM_ReconstructionWorkload)
     ->Args({0, 0})
     ->Args({4, 0})
     ->Args({0, 3})
+    ->Args({0, 7})
     ->ArgNames({"creep_plays", "hinges_per_play"});
 
 // Tail latency: every one of kTimedSamples samples timed on its own with steady_clock, so the
@@ -184,6 +185,7 @@ BENCHMARK(BM_ReconstructionWorkloadTail)
     ->Args({0, 0})
     ->Args({4, 0})
     ->Args({0, 3})
+    ->Args({0, 7})
     ->ArgNames({"creep_plays", "hinges_per_play"})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond);

@@ -14,8 +14,9 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 bash "$root/scripts/main_job.sh" "$build" "$out" | tee "$out/main_job.out"
 [ "$(grep -c 'selfsensed exited with status 0' "$out/main_job.out")" = 2 ] ||
   fail "a selfsensed did not exit 0 on SIGTERM: $(grep 'exited with status' "$out/main_job.out")"
-# Figures (measured: S_hat 0.17 %, true S 0.68 %; T_hat 0.26 %, true T 9.0 %): the loop holds the
-# self-sensed signal on the setpoint; the true one is off by the model's error.
+# Figures (measured: S_hat 0.19 %, true S 0.22 %; T_hat 0.34 %, true T 0.98-1.04 %): the loop holds
+# the self-sensed signal on the setpoint; the true one is off by the model's error. The true
+# figures are asserted at the daemon issue's goals (0.5 % and 2 %).
 check() {  # check SEGMENT COLUMN LIMIT_PERCENT
   local v
   v=$(sed -n "s/^$1: .* $2 \([0-9.]*\) % RMS.*/\1/p" "$out/figures.txt")
@@ -24,9 +25,9 @@ check() {  # check SEGMENT COLUMN LIMIT_PERCENT
   echo "ok: $1 $2 $v % < $3 %"
 }
 check position S_hat 0.5
-check position S 1.5
+check position S 0.5
 check force T_hat 0.8
-check force T 15
+check force T 2
 # The damping run (config/damping-sim.yaml, a 300 Hz mount with 1 % damping, `ctl impulse`):
 # measured 156.8 ms -> 9.9-11.0 ms on true S, 14.3-15.8x; the issue's goal is 10x.
 ratio=$(sed -n 's/^damping: ring-down shortened \([0-9.]*\)x on true S.*/\1/p' "$out/figures.txt")

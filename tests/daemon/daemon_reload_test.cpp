@@ -145,7 +145,7 @@ TEST(DaemonReload, FiltersAndCommandLimitsChangeWhileArmed) {
                                                      "command_v_per_m: [0.0, 1.0e6]"};
   const std::pair<std::string, std::string> new_filters{
       "- {type: notch, frequency_hz: 2000.0,",
-      "- {type: low-pass-1, frequency_hz: 4000.0}\n    - {type: notch, frequency_hz: 1800.0,"};
+      "- {type: low-pass-1, frequency_hz: 2100.0}\n    - {type: notch, frequency_hz: 1800.0,"};
   testing::write_text(config, with({narrower, new_filters, {"priority: 80", "priority: 70"}}));
   nlohmann::json r = daemon.request(R"({"request": "reload"})");
   EXPECT_FALSE(r.value("ok", true)) << r.dump();

@@ -17,8 +17,8 @@ namespace {
 
 using testing::RunningDaemon;
 
-constexpr double kRate = 10000.0;  // config/sim.yaml
-constexpr int kArmed = 2;          // the recording's state column (contracts.md)
+constexpr double kRate = testing::kProcessTestRate;
+constexpr int kArmed = 2;  // the recording's state column (contracts.md)
 
 TEST(DaemonStop, SigtermWhileArmedRampsToTheSafeOutputThenExitsZero) {
   const testing::ScratchDir dir("daemon-stop");

@@ -8,12 +8,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <numbers>
 #include <vector>
 
 #include "selfsense/identification/fit_quality.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
 #include "sim/simulated_transducer.hpp"
 #include "support/daemon_plant.hpp"
 
@@ -23,9 +25,12 @@ namespace {
 constexpr double kRate = 10000.0;
 constexpr double kTs = 1.0 / kRate;
 
+// The daemon's shipped model (config/models/sim.yaml: `preisach-creep` identified on the bench's
+// identification recording, config/plant/daemon.yaml, the plant of test::daemon_plant), so the
+// figures are the product's.
 const models::TransducerModel& bench_model() {
   static const models::TransducerModel m =
-      test::identify_daemon_plant(test::daemon_plant(kRate), 40.0);
+      models::load_model(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config/models/sim.yaml");
   return m;
 }
 
@@ -161,10 +166,10 @@ TEST(Loop, PositionTracksAStaircaseAndASineOnTheSelfSensedStrain) {
   const Tracking t = track(b, sp, scored, false);
   std::printf("position: true S %.3f %% of range RMS, S_hat %.3f %%\n", 100 * t.truth_nrmse,
               100 * t.hat_nrmse);
-  // The loop holds S_hat on the setpoint (measured 0.28 %); the true S is off by the model's
-  // error under the load spring (measured 3.4 %; the goal of 0.5 % is open, see the issue).
+  // The loop holds S_hat on the setpoint (measured 0.26 %); the true S is off by that and the
+  // model's error under the load spring (measured 0.285 %; the daemon issue's goal is 0.5 %).
   EXPECT_LT(t.hat_nrmse, 0.004);
-  EXPECT_LT(t.truth_nrmse, 0.045);
+  EXPECT_LT(t.truth_nrmse, 0.004);
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
 }
 
@@ -187,11 +192,11 @@ TEST(Loop, PositionAgainstOpenLoopFeedforwardAndTheUncompensatedLinearDrive) {
       "true S against the setpoint: closed loop on S_hat %.2f %%, open-loop feedforward "
       "%.2f %%, uncompensated linear drive %.2f %% of range RMS\n",
       100 * closed, 100 * feedforward, 100 * uncompensated);
-  // Measured 3.45 %, 14.24 %, 16.01 %. Open loop, the compensator removes the hysteresis but not
+  // Measured 0.28 %, 14.39 %, 16.01 %. Open loop, the compensator removes the hysteresis but not
   // the load spring's push-back (its inverse holds the static load); the loop on S_hat does.
   EXPECT_LT(feedforward, 0.185);
   EXPECT_LT(feedforward, uncompensated);
-  EXPECT_LT(closed, 0.5 * feedforward);
+  EXPECT_LT(closed, 0.05 * feedforward);
 }
 
 // A reload's tuning while armed is all or nothing: with an unstable filter section it is
@@ -223,32 +228,58 @@ TEST(Loop, ATuningWhileArmedIsTakenAllOrNothing) {
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
 }
 
-TEST(Loop, ForceTracksStepsOnTheSelfSensedStress) {
-  Bench b(test::daemon_plant(kRate), bench_control());
-  start(b, ControlMode::kForce);
+// Force steps within reach of 0 .. 2 MV/m against the preload (-3.3 MPa at 0 V/m), 0.6 s each,
+// scored from 0.15 s after each step.
+Tracking force_steps(Bench& b) {
   std::vector<double> sp;
   std::vector<bool> scored;
-  // Within reach of 0 .. 2 MV/m against the preload (-3.3 MPa at 0 V/m).
   for (const double level : {-5.0e6, -8.0e6, -6.0e6, -9.0e6, -4.5e6}) {
     for (int k = 0; k < static_cast<int>(0.6 * kRate); ++k) {
       sp.push_back(level);
       scored.push_back(k >= static_cast<int>(0.15 * kRate));
     }
   }
-  const Tracking t = track(b, sp, scored, true);
+  return track(b, sp, scored, true);
+}
+
+TEST(Loop, ForceTracksStepsOnTheSelfSensedStress) {
+  Bench b(test::daemon_plant(kRate), bench_control());
+  start(b, ControlMode::kForce);
+  const Tracking t = force_steps(b);
   std::printf("force: true T %.3f %% of range RMS, T_hat %.3f %%\n", 100 * t.truth_nrmse,
               100 * t.hat_nrmse);
-  // T_hat on the setpoint (measured 0.39 %); the true T off by the model's stress error under
-  // the load spring (measured 17 %; the goal of 2 % is open, see the issue).
+  // T_hat on the setpoint (measured 0.34 %); the true T off by that and the model's stress
+  // error (measured 0.46 %; the daemon issue's goal is 2 %).
   EXPECT_LT(t.hat_nrmse, 0.008);
-  EXPECT_LT(t.truth_nrmse, 0.22);
+  EXPECT_LT(t.truth_nrmse, 0.0075);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+}
+
+// The same steps after a position run to 1.2e-3 and back to 0 (another field history, so
+// another hysteresis state at each step: the model's error depends on it).
+TEST(Loop, ForceTracksStepsAfterAPositionRun) {
+  Bench b(test::daemon_plant(kRate), bench_control());
+  start(b, ControlMode::kPosition);
+  for (const double strain : {1.2e-3, 0.0}) {
+    b.send({0, CommandKind::kSetpoint, strain});
+    b.run(0.5);
+  }
+  ASSERT_EQ(b.send({0, CommandKind::kDisarm}), CommandResult::kDone);
+  ASSERT_EQ(b.send({0, CommandKind::kMode, 0.0, ControlMode::kForce}), CommandResult::kDone);
+  ASSERT_EQ(b.send({0, CommandKind::kArm}), CommandResult::kDone);
+  const Tracking t = force_steps(b);
+  std::printf("force after position: true T %.3f %% of range RMS, T_hat %.3f %%\n",
+              100 * t.truth_nrmse, 100 * t.hat_nrmse);
+  // Measured 0.77 % (T_hat 0.34 %).
+  EXPECT_LT(t.hat_nrmse, 0.008);
+  EXPECT_LT(t.truth_nrmse, 0.012);
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
 }
 
 // Collocated damping on the self-sensed strain (the paper's cantilever application): a mass on
 // the stack rings at 300 Hz with 1 % damping after a 300 N, 0.5 ms force impulse. Armed in
 // open-loop (the inverse model holds the position) it rings down to 5 % of its first peak in
-// about 0.16 s; in damping mode (positive position feedback tuned to the mode) 14x faster.
+// about 0.16 s; in damping mode (positive position feedback tuned to the mode) 15x faster.
 double ring_down_s(ControlMode mode, const models::TransducerModel& model = bench_model()) {
   ControllerConfig c = bench_control();
   c.damping = {control::DampingController::Law::kPositivePosition,
@@ -283,23 +314,25 @@ TEST(Loop, DampingShortensTheRingDownTenfold) {
   std::printf("ring-down to 5 %%: open loop %.4f s, damping %.4f s (%.1fx)\n", open, damped,
               open / damped);
   EXPECT_GT(open, 0.1);            // the undamped mode rings (measured 0.16 s)
-  EXPECT_GT(open / damped, 10.0);  // the issue's goal; measured 14x
+  EXPECT_GT(open / damped, 10.0);  // the issue's goal; measured 15.4x
 }
 
 // The paper's comparison (20x with a constant permittivity, 60x with eps(E)): the same damping
 // run with S_hat from models of the same recording that leave out the dielectric's
 // nonlinearity (linear: constant permittivity) or keep only its static curve (permittivity:
-// eps(E), no hysteresis), against the hysteresis-creep model above.
+// eps(E), no hysteresis), against a hysteresis-creep model of that recording (40 s of ramps;
+// the shipped model comes from another recording).
 TEST(Loop, DampingWithAConstantPermittivityAgainstEpsOfE) {
   const plant::PlantConfig recorded = test::daemon_plant(kRate);
   const models::TransducerModel linear =
       test::identify_daemon_plant(recorded, 40.0, models::Structure::kLinear);
   const models::TransducerModel eps_of_e =
       test::identify_daemon_plant(recorded, 40.0, models::Structure::kPermittivity);
+  const models::TransducerModel hysteresis_creep = test::identify_daemon_plant(recorded, 40.0);
   const double open = ring_down_s(ControlMode::kOpenLoop);
   const double with_linear = ring_down_s(ControlMode::kDamping, linear);
   const double with_eps = ring_down_s(ControlMode::kDamping, eps_of_e);
-  const double with_full = ring_down_s(ControlMode::kDamping);
+  const double with_full = ring_down_s(ControlMode::kDamping, hysteresis_creep);
   std::printf(
       "ring-down shortened: constant permittivity %.1fx, eps(E) %.1fx, hysteresis-creep "
       "%.1fx\n",

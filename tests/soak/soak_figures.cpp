@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <map>
 
+#include "support/sanitizers.hpp"
+
 namespace selfsense::soak {
 namespace {
 
@@ -13,17 +15,7 @@ constexpr double kMib = 1024.0 * 1024.0;
 
 // AddressSanitizer keeps freed memory in its quarantine (up to 256 MiB) before reusing it, so the
 // daemon's resident memory grows under it by design: measured there, asserted in other builds.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
+using test::kAddressSanitizer;
 
 std::uint64_t counter(const nlohmann::json& status, const char* name) {
   const auto& c = status.value("counters", nlohmann::json::object());

@@ -26,7 +26,9 @@ struct IdentificationOptions {
   std::size_t bias_levels{0};      // hinges per play (OperatorStructure::bias_levels)
   // preisach-creep chooses sizes per side on the fitting data alone, by the output error on
   // its last quarter of a fit on the first three quarters: dead zones between 0 and
-  // dead_zones, then bias_levels among kBiasLevelCandidates.
+  // dead_zones, then bias_levels among kBiasLevelCandidates (levels at k / (n + 1) of the
+  // input range: each count's levels contain the smaller ones', so a larger count never fits
+  // worse).
   bool choose_bias_levels{false};
   bool choose_dead_zones{false};
   // stress-hysteresis chooses its play count among kStressPlayCandidates on the fitting data
@@ -34,7 +36,7 @@ struct IdentificationOptions {
   // quarter of a fit on the first three quarters.
   bool choose_plays{false};
 };
-inline constexpr std::array<std::size_t, 3> kBiasLevelCandidates{0, 1, 3};
+inline constexpr std::array<std::size_t, 4> kBiasLevelCandidates{0, 1, 3, 7};
 inline constexpr std::array<std::size_t, 3> kStressPlayCandidates{16, 24, 48};
 [[nodiscard]] IdentificationOptions defaults_for(Structure s) noexcept;
 

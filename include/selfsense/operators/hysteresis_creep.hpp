@@ -19,7 +19,9 @@
 // With hinges H~ is no longer a PI operator: the sample's output is still piecewise linear in
 // x (each play moves with x or holds, each hinge is on or off), so x is solved for by a
 // safeguarded Newton iteration on that function (bisection inside a bracket when Newton
-// leaves it), which lands exactly once it reaches the right piece; the root is unique while
+// leaves it), which lands exactly once it reaches the right piece: each evaluation also gives
+// the kinks around x, so a step that stays in its piece is the root (one evaluation for most
+// samples); the root is unique while
 // H~ increases in x, and when hinges bend it back, a root next to the PI part's inverse is taken.
 //
 // step() and inverse_step() are real-time safe: O(n_plays + n_creep + n_deadzones + n_hinges)
@@ -28,6 +30,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -67,7 +70,7 @@ class HysteresisCreep final {
   double step(double x) noexcept;
   void apply(std::span<const double> x, std::span<double> y) noexcept;
   // The input x that would make this sample's output equal y. Does not change the state
-  // (the non-const is for a scratch buffer).
+  // (the non-const is for a scratch buffer and, with hinges, where the next solve starts).
   [[nodiscard]] double input_for(double y) noexcept;
   // Inverse: input_for(y), then advance with that x, so forward and inverse share one state.
   double inverse_step(double y) noexcept;
@@ -95,8 +98,16 @@ class HysteresisCreep final {
   [[nodiscard]] double inner_step(double x) noexcept;  // H[x] + K[x], advancing the state
   [[nodiscard]] double hinge_sum(std::span<const double> plays) const noexcept;
   // H~ at input x from the current state, and its slope in x there, without advancing.
-  [[nodiscard]] double trial_inner(double x, double* slope) const noexcept;
-  [[nodiscard]] double solve_inner(double target) const noexcept;  // H~[x] = target
+  struct Trial {
+    double value;       // H~ at x
+    double slope_down;  // dH~/dx on [below, x]
+    double slope_up;    // dH~/dx on [x, above]
+    double below;       // the nearest kinks below and above x
+    double above;
+  };
+  [[nodiscard]] Trial trial_inner(double x) const noexcept;
+  // H~[x] = target, the iteration started at `start`.
+  [[nodiscard]] double solve_inner(double target, double start) const noexcept;
 
   Params params_{};
   double sample_time_{0.0};
@@ -115,6 +126,9 @@ class HysteresisCreep final {
   std::vector<std::size_t> hinge_rows_{};     // play index of each hinge
   double scale_{1.0};                         // input scale of the inverse's first step
   std::vector<double> state_{};               // plays, then lags
+  // The previous sample's inverse with hinges: where the next solve starts. Not the input
+  // applied (state_[0]): in a loop the feedback moves that far from the feedforward's root.
+  double last_root_{std::numeric_limits<double>::quiet_NaN()};
 };
 
 // Feedforward inverse compensator (the paper's reference [11]): desired output in, actuator
