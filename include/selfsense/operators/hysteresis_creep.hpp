@@ -20,9 +20,10 @@
 // x (each play moves with x or holds, each hinge is on or off), so x is solved for by a
 // safeguarded Newton iteration on that function (bisection inside a bracket when Newton
 // leaves it), which lands exactly once it reaches the right piece: each evaluation also gives
-// the kinks around x, so a step that stays in its piece is the root (one evaluation for most
-// samples); the root is unique while
-// H~ increases in x, and when hinges bend it back, a root next to the PI part's inverse is taken.
+// the slopes on both sides of x and the kinks around it, so a step that stays in its piece is
+// the root (one evaluation for most samples, starting at the previous sample's root); the root
+// is unique while H~ increases in x, and when hinges bend it back, a root next to the PI part's
+// inverse is taken.
 //
 // step() and inverse_step() are real-time safe: O(n_plays + n_creep + n_deadzones + n_hinges)
 // (the inverse with hinges a bounded number of such evaluations), no allocation, no
@@ -97,7 +98,8 @@ class HysteresisCreep final {
   }
   [[nodiscard]] double inner_step(double x) noexcept;  // H[x] + K[x], advancing the state
   [[nodiscard]] double hinge_sum(std::span<const double> plays) const noexcept;
-  // H~ at input x from the current state, and its slope in x there, without advancing.
+  // H~ at input x from the current state, without advancing, and the linear pieces on either
+  // side of x.
   struct Trial {
     double value;       // H~ at x
     double slope_down;  // dH~/dx on [below, x]
