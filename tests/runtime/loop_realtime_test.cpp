@@ -149,6 +149,7 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
 TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithTheShippedPreisachModel) {
   const models::TransducerModel model =
       models::load_model(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config/models/sim.yaml");
+  ASSERT_TRUE(model.actuator.has_value());
   ASSERT_FALSE(model.actuator->op.hinges.weights.empty());
   every_mode_without_allocating(model);
 }
