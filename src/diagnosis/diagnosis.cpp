@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -73,8 +74,16 @@ const std::vector<Candidate>& candidates() {
        false,
        Needs::kNothing},
       // S ~ P^2: the model's D for field drive, the imposed D (the drive) for charge drive.
-      {"electrostriction", {CorrectionTerm::kSensedQuadratic}, false, true, Needs::kSensed},
-      {"electrostriction", {CorrectionTerm::kDrivePolynomial}, false, true, Needs::kChargeDrive},
+      {"electrostriction",
+       {CorrectionTerm::kSensedQuadratic, CorrectionTerm::kOffset},
+       false,
+       true,
+       Needs::kSensed},
+      {"electrostriction",
+       {CorrectionTerm::kDrivePolynomial, CorrectionTerm::kOffset},
+       false,
+       true,
+       Needs::kChargeDrive},
   };
   return list;
 }
@@ -85,7 +94,7 @@ double range_of(std::span<const double> x) {
   return *hi - *lo;
 }
 
-// printf-style "%.3g", "%.0f" and "%%" only (the math libraries do no stdio).
+// printf-style "%.3g", "%+.3g", "%.0f" and "%%" only (the math libraries do no stdio).
 std::string format(const char* fmt, double a, double b = 0.0, double c = 0.0) {
   const double args[3] = {a, b, c};
   std::size_t next = 0;
@@ -100,6 +109,8 @@ std::string format(const char* fmt, double a, double b = 0.0, double c = 0.0) {
       out << '%';
       continue;
     }
+    const bool sign = *p == '+';
+    if (sign) ++p;
     int digits = 6;
     if (*p == '.') {
       digits = 0;
@@ -107,6 +118,7 @@ std::string format(const char* fmt, double a, double b = 0.0, double c = 0.0) {
         digits = digits * 10 + (*p - '0');
     }
     const double v = next < 3 ? args[next++] : 0.0;
+    if (sign && !(v < 0.0)) out << '+';
     if (*p == 'f') {
       out << std::fixed << std::setprecision(digits) << v << std::defaultfloat;
     } else {
@@ -125,8 +137,6 @@ struct ChannelData {
   std::span<const double> sensed_model{};  // the model's sensed output (electrostriction)
 };
 
-// Share of the residual variance removed in each held-out block; the median is the figure a
-// candidate must reach (one block it fits by chance does not carry it).
 // Which samples fit and which judge: sample k lies in block (k blocks) / n; even blocks fit,
 // odd ones judge. Samples where the model gave no finite output do neither.
 struct Rows {
@@ -151,10 +161,16 @@ Rows make_rows(const std::vector<bool>& usable, std::size_t blocks) {
   return r;
 }
 
-// Share of the residual variance removed in each held-out block; the median is the figure a
-// candidate must reach (one block it fits by chance does not carry it).
-double median_block_explains(std::span<const double> recorded, const std::vector<double>& before,
-                             const std::vector<double>& after, const Rows& rows) {
+// Share of the residual variance removed in each held-out block: the median is the figure a
+// candidate must reach (one block it fits by chance does not carry it), the worst says whether
+// it makes some stretch worse (a term that does will not carry over to new data either).
+struct BlockShares {
+  double median{0.0};
+  double worst{0.0};
+};
+
+BlockShares block_explains(std::span<const double> recorded, const std::vector<double>& before,
+                           const std::vector<double>& after, const Rows& rows) {
   std::vector<double> e0(rows.blocks, 0.0);
   std::vector<double> e1(rows.blocks, 0.0);
   for (std::size_t k = 0; k < recorded.size(); ++k) {
@@ -166,9 +182,9 @@ double median_block_explains(std::span<const double> recorded, const std::vector
   for (std::size_t b = 1; b < rows.blocks; b += 2) {
     if (e0[b] > 0.0) share.push_back(1.0 - e1[b] / e0[b]);
   }
-  if (share.empty()) return 0.0;
+  if (share.empty()) return {};
   std::sort(share.begin(), share.end());
-  return share[share.size() / 2];
+  return {share[share.size() / 2], share.front()};
 }
 
 double sse_over(std::span<const double> recorded, const std::vector<double>& model,
@@ -365,7 +381,7 @@ void describe(Finding& f, const ChannelCorrection& c, const ChannelData& ch, con
       f.evidence = "the recorded " + n +
                    format(
                        " follows the square of the polarization (Q = %.3g m^4/C^2 on the "
-                       "model's D)",
+                       "model's D - d T)",
                        c.sensed_quadratic) +
                    tail;
     } else {  // charge drive: P ~ the imposed D
@@ -442,10 +458,10 @@ std::size_t complexity(const std::vector<CorrectionTerm>& terms) {
         n += 5;
         break;
       case CorrectionTerm::kHysteresis:
-        n += 8;  // plays (correction_fit.cpp)
+        n += 9;  // the linear play and 8 plays (correction_fit.cpp)
         break;
       case CorrectionTerm::kAsymmetricHysteresis:
-        n += 8 + 27;  // plays and their hinges
+        n += 9 + 27;  // plays and their hinges
         break;
       default:
         n += 1;
@@ -618,14 +634,21 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
   }
 
   const std::size_t blocks = std::max<std::size_t>(2, options.blocks);
-  // The channels hold their own copies; the electrostriction term reads this one.
+  // The channels hold their own copies; the electrostriction term reads the sensed channel's
+  // response to the drive alone (D - d T: the polarization and the dielectric part).
   static_cast<void>(hold_finite(outputs.sensed));
+  std::vector<double> sensed_response = outputs.sensed;
+  if (!s.stress.empty()) {
+    const double d = coupling_of(model.sensor);
+    for (std::size_t k = 0; k < n; ++k)
+      sensed_response[k] -= d * s.stress[k];
+  }
 
   Result result;
   result.improved = base;
   for (ChannelData& ch : channels) {
     const Rows rows = make_rows(hold_finite(ch.base), blocks);
-    ch.sensed_model = outputs.sensed;
+    ch.sensed_model = sensed_response;
     const std::vector<bool>& fit_rows = rows.fit;
     identification::CorrectionSignals cs;
     cs.y = ch.base;
@@ -633,7 +656,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     cs.drive = s.drive;
     cs.stress = s.stress;
     cs.temperature = s.temperature;
-    cs.sensed = has_sensor ? std::span<const double>(outputs.sensed) : std::span<const double>();
+    cs.sensed = has_sensor ? std::span<const double>(sensed_response) : std::span<const double>();
     std::vector<double> response(ch.base);
     if (!s.stress.empty()) {
       for (std::size_t k = 0; k < n; ++k)
@@ -655,7 +678,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         const Candidate* candidate;
         identification::CorrectionFit fit;
         double explains;
-        double typical;  // median over the held-out blocks
+        BlockShares blocks;  // over the held-out blocks
       };
       std::vector<Tried> tried;
       for (const Candidate& c : candidates()) {
@@ -681,9 +704,12 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
           }
           identification::CorrectionFit fit =
               identification::fit_correction(cs, terms, start, fit_rows);
+          // A correction that must rescale the model's own output by more than 100 % is a
+          // different model, not physics the model left out (re-identify instead).
+          if (std::abs(fit.correction.gain) > options.max_gain) continue;
           const double sse = sse_over(ch.recorded, fit.output, rows.judge);
-          const double typical = median_block_explains(ch.recorded, current, fit.output, rows);
-          tried.push_back({&c, std::move(fit), 1.0 - sse / current_sse, typical});
+          const BlockShares shares = block_explains(ch.recorded, current, fit.output, rows);
+          tried.push_back({&c, std::move(fit), 1.0 - sse / current_sse, shares});
         } catch (const std::invalid_argument&) {
           continue;  // no finite fit of this candidate on these signals: not a candidate here
         }
@@ -692,18 +718,25 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       std::sort(tried.begin(), tried.end(),
                 [](const Tried& a, const Tried& b) { return a.explains > b.explains; });
       const auto significant = [&](const Tried& t) {
-        return t.explains >= options.min_explains && t.typical >= options.min_explains &&
+        return t.explains >= options.min_explains && t.blocks.median >= options.min_explains &&
+               t.blocks.worst >= -options.max_block_loss &&
                t.explains * current_sse >= options.min_share * original_sse;
       };
-      // Specific physics first: when one is significant, the generic candidates only compete
-      // as alternatives (and may explain what is left in a later round).
-      std::size_t pool = tried.size();
-      if (std::any_of(tried.begin(), tried.end(),
-                      [&](const Tried& t) { return !t.candidate->generic && significant(t); })) {
-        const auto specific_end = std::stable_partition(
-            tried.begin(), tried.end(), [](const Tried& t) { return !t.candidate->generic; });
-        pool = static_cast<std::size_t>(specific_end - tried.begin());
+      // Specific physics first: when one is significant, a generic candidate competes only if
+      // it leaves clearly less (a loop the specific terms merely resemble); otherwise it is an
+      // alternative and may explain what is left in a later round.
+      double specific_left = std::numeric_limits<double>::infinity();
+      for (const Tried& t : tried) {
+        if (!t.candidate->generic && significant(t)) {
+          specific_left = std::min(specific_left, 1.0 - t.explains);
+        }
       }
+      const auto competes = [&](const Tried& t) {
+        return !t.candidate->generic || 1.0 - t.explains <= options.generic_ratio * specific_left;
+      };
+      const auto pool = static_cast<std::size_t>(
+          std::stable_partition(tried.begin(), tried.end(), competes) - tried.begin());
+      if (pool == 0) break;
       // Of the candidates explaining about as much as the best, the simplest.
       std::size_t chosen = 0;
       for (std::size_t i = 1; i < pool; ++i) {

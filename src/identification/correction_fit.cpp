@@ -64,6 +64,10 @@ std::vector<double> log_spaced(double from, double to, std::size_t per_decade) {
   return out;
 }
 
+bool has_term(std::span<const CorrectionTerm> terms, CorrectionTerm t) {
+  return std::find(terms.begin(), terms.end(), t) != terms.end();
+}
+
 Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm> terms) {
   const std::size_t n = s.y.size();
   Columns c;
@@ -131,6 +135,13 @@ Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm>
       }
       case CorrectionTerm::kHysteresis:
       case CorrectionTerm::kAsymmetricHysteresis: {
+        // The asymmetric bank contains the plain one: one bank when both are asked for.
+        if (t == CorrectionTerm::kHysteresis &&
+            has_term(terms, CorrectionTerm::kAsymmetricHysteresis)) {
+          break;
+        }
+        // A PI operator of the drive: its linear play (x itself) and the plays beside it.
+        add([&](std::size_t k) { return s.drive[k]; });
         const std::vector<std::vector<double>> plays = drive_plays(s.drive, c.play_thresholds);
         for (const auto& p : plays)
           add([&](std::size_t k) { return p[k] - s.drive[k]; });
@@ -198,6 +209,11 @@ void apply_coefficients(std::span<const CorrectionTerm> terms, const Columns& co
         break;
       case CorrectionTerm::kHysteresis:
       case CorrectionTerm::kAsymmetricHysteresis:
+        if (t == CorrectionTerm::kHysteresis &&
+            has_term(terms, CorrectionTerm::kAsymmetricHysteresis)) {
+          break;
+        }
+        out.drive_linear = c[i++];
         out.hysteresis_thresholds = columns.play_thresholds;
         out.hysteresis_weights.clear();
         for (std::size_t j = 0; j < columns.play_thresholds.size(); ++j)
@@ -368,9 +384,20 @@ Solved solve(std::span<const double> target, const std::vector<std::vector<doubl
   for (Eigen::Index i = 0; i < p; ++i) {
     if (!(scale[i] > 0.0)) scale[i] = 1.0;
   }
-  Eigen::MatrixXd gs = scale.cwiseInverse().asDiagonal() * g * scale.cwiseInverse().asDiagonal();
-  gs.diagonal().array() += 1e-10;
-  const Eigen::VectorXd theta = gs.ldlt().solve(b.cwiseQuotient(scale));
+  const Eigen::MatrixXd gs =
+      scale.cwiseInverse().asDiagonal() * g * scale.cwiseInverse().asDiagonal();
+  // Minimum-norm solution: directions the rows cannot tell apart (columns nearly collinear on
+  // these samples, e.g. the drive and a model output proportional to it) get no weight, rather
+  // than large opposite weights that cancel here and nowhere else.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gs);
+  const Eigen::VectorXd& lambda = eig.eigenvalues();
+  const double floor = 1e-10 * std::max(lambda.maxCoeff(), 0.0);
+  const Eigen::VectorXd projected = eig.eigenvectors().transpose() * b.cwiseQuotient(scale);
+  Eigen::VectorXd weighted = Eigen::VectorXd::Zero(p);
+  for (Eigen::Index i = 0; i < p; ++i) {
+    if (lambda[i] > floor) weighted[i] = projected[i] / lambda[i];
+  }
+  const Eigen::VectorXd theta = eig.eigenvectors() * weighted;
   out.coefficients = theta.cwiseQuotient(scale);
   out.sse = std::max(
       0.0, energy - 2.0 * out.coefficients.dot(b) + out.coefficients.dot(g * out.coefficients));
@@ -443,7 +470,10 @@ CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const Correct
   fit.correction = best_filters;
   fit.correction.temperature_reference_degc = s.temperature_reference_degc;
   apply_coefficients(terms, columns, best.coefficients, fit.correction);
-  if (1.0 + fit.correction.gain <= 0.0) fit.correction.gain = 0.0;  // keep it invertible
+  if (!(1.0 + fit.correction.gain > 0.0)) {
+    // The model's output would enter inverted (or not at all): not a correction of it.
+    throw std::invalid_argument("fit_correction: the fit needs 1 + gain <= 0");
+  }
   fit.output = apply_correction(s, fit.correction);
   for (std::size_t k = 0; k < n; ++k) {
     if (!fit_rows[k]) continue;

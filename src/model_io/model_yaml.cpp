@@ -126,7 +126,7 @@ std::optional<InputRange> read_range(YamlMap& map, std::string_view key) {
 // The scalar keys of a correction (channel_correction.hpp), shared by reading and writing.
 template <typename C>
 auto correction_scalars(C& c) {
-  return std::array<std::pair<const char*, decltype(&c.gain)>, 15>{{
+  return std::array<std::pair<const char*, decltype(&c.gain)>, 16>{{
       {"gain", &c.gain},
       {"offset", &c.offset},
       {"temperature_reference_degc", &c.temperature_reference_degc},
@@ -137,6 +137,7 @@ auto correction_scalars(C& c) {
       {"stress_quadratic_per_pa2", &c.stress_quadratic_per_pa2},
       {"drive_quadratic", &c.drive_quadratic},
       {"drive_cubic", &c.drive_cubic},
+      {"drive_linear", &c.drive_linear},
       {"sensed_quadratic", &c.sensed_quadratic},
       {"dynamics_frequency_hz", &c.dynamics_frequency_hz},
       {"dynamics_damping", &c.dynamics_damping},

@@ -27,6 +27,7 @@ bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) co
       {"stress_quadratic_per_pa2", stress_quadratic_per_pa2},
       {"drive_quadratic", drive_quadratic},
       {"drive_cubic", drive_cubic},
+      {"drive_linear", drive_linear},
       {"sensed_quadratic", sensed_quadratic},
       {"dynamics_frequency_hz", dynamics_frequency_hz},
       {"dynamics_damping", dynamics_damping},
@@ -132,9 +133,9 @@ bool ChannelCorrection::empty() const noexcept {
   return gain == 0.0 && offset == 0.0 && temperature_gain_per_k == 0.0 &&
          temperature_offset_per_k == 0.0 && temperature_drive_per_k == 0.0 &&
          stress_gain_per_pa == 0.0 && stress_quadratic_per_pa2 == 0.0 && drive_quadratic == 0.0 &&
-         drive_cubic == 0.0 && sensed_quadratic == 0.0 && creep_weights.empty() &&
-         dynamics_frequency_hz == 0.0 && leakage_tau_s == 0.0 && delay_s == 0.0 &&
-         hysteresis_weights.empty() && hinge_weights.empty();
+         drive_cubic == 0.0 && drive_linear == 0.0 && sensed_quadratic == 0.0 &&
+         creep_weights.empty() && dynamics_frequency_hz == 0.0 && leakage_tau_s == 0.0 &&
+         delay_s == 0.0 && hysteresis_weights.empty() && hinge_weights.empty();
 }
 
 CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sample_time)
@@ -200,7 +201,7 @@ double CorrectionStage::terms(const Inputs& in) const noexcept {
   const double dtheta = in.temperature - c_.temperature_reference_degc;
   const double x = in.drive;
   return c_.offset + (c_.temperature_offset_per_k + c_.temperature_drive_per_k * x) * dtheta +
-         c_.drive_quadratic * x * x + c_.drive_cubic * x * x * x +
+         c_.drive_linear * x + c_.drive_quadratic * x * x + c_.drive_cubic * x * x * x +
          c_.sensed_quadratic * in.sensed * in.sensed;
 }
 

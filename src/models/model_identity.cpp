@@ -74,6 +74,7 @@ void add_correction(Fnv1a& h, const std::optional<ChannelCorrection>& c) noexcep
     h.add(c->hinge_levels);
     h.add(c->hinge_weights);
   }
+  if (c->drive_linear != 0.0) h.add(c->drive_linear);  // likewise for corrections without it
 }
 
 void add_vectorial_side(Fnv1a& h, const std::optional<StressHysteresisSide>& side) noexcept {

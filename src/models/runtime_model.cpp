@@ -315,8 +315,10 @@ Reconstruction::Estimate Reconstruction::kernel_step(double drive, double sensed
     out.stress = stress;
   }
   if (strain_fix_) {
-    out.strain = strain_fix_->step(
-        {out.strain, x, out.stress, temperature_, y, out.strain - strain_coupling_ * out.stress});
+    // The electrostriction term reads the sensed response to the drive alone, as forward.
+    out.strain = strain_fix_->step({out.strain, x, out.stress, temperature_,
+                                    y - sensed_coupling_ * out.stress,
+                                    out.strain - strain_coupling_ * out.stress});
   }
   return out;
 }
@@ -391,8 +393,9 @@ Simulation::Output Simulation::kernel_step(double drive, double stress) noexcept
     const StressHysteresisForward::Output o = std::get<Vectorial>(impl_)->step(drive, stress);
     out = {o.sensed, o.strain, SampleStatus::kOk};
   }
-  // A model without a sensor side has NaN there; the electrostriction term then has nothing.
-  const double base_sensed = std::isnan(out.sensed) ? 0.0 : out.sensed;
+  // The electrostriction term reads the sensed channel's response to the drive alone (D - d T);
+  // a model without a sensor side has NaN there, and the term then has nothing.
+  const double base_sensed = std::isnan(out.sensed) ? 0.0 : out.sensed - sensed_coupling_ * stress;
   if (sensed_fix_) {
     out.sensed = sensed_fix_->step({out.sensed, drive, stress, temperature_, base_sensed,
                                     out.sensed - sensed_coupling_ * stress});

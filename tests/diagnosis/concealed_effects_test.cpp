@@ -142,9 +142,6 @@ double nrmse(const std::vector<double>& recorded, const std::vector<double>& mod
 struct Expected {
   std::string effect;
   std::string channel;  // "D" or "S": its validation nrmse must fall by at least half
-  // An effect that explains the same residual on these data: naming it is accepted when it
-  // lists `effect` among its alternatives (both reported as candidates with their evidence).
-  std::string or_alternative_of{};
 };
 
 struct Case {
@@ -200,14 +197,9 @@ Outcome run_case(const Case& c) {
 }
 
 bool named(const Outcome& o, const Expected& e) {
-  return std::any_of(o.result.findings.begin(), o.result.findings.end(),
-                     [&](const diagnosis::Finding& f) {
-                       if (f.channel != e.channel) return false;
-                       if (f.effect == e.effect) return true;
-                       return !e.or_alternative_of.empty() && f.effect == e.or_alternative_of &&
-                              std::find(f.alternatives.begin(), f.alternatives.end(), e.effect) !=
-                                  f.alternatives.end();
-                     });
+  return std::any_of(
+      o.result.findings.begin(), o.result.findings.end(),
+      [&](const diagnosis::Finding& f) { return f.channel == e.channel && f.effect == e.effect; });
 }
 
 class ConcealedEffect : public ::testing::TestWithParam<Case> {};
@@ -223,6 +215,18 @@ TEST_P(ConcealedEffect, NamedAndValidationErrorHalved) {
     return;
   }
   EXPECT_TRUE(o.result.mismatch);
+  // Named first: the first finding on each affected channel is a planted effect, not physics
+  // the planted one merely resembles.
+  for (const Expected& e : c.expected) {
+    const auto first =
+        std::find_if(o.result.findings.begin(), o.result.findings.end(),
+                     [&](const diagnosis::Finding& f) { return f.channel == e.channel; });
+    ASSERT_NE(first, o.result.findings.end()) << "nothing named on " << e.channel;
+    EXPECT_TRUE(std::any_of(
+        c.expected.begin(), c.expected.end(),
+        [&](const Expected& x) { return x.channel == e.channel && x.effect == first->effect; }))
+        << first->effect << " named first on " << e.channel;
+  }
   for (const Expected& e : c.expected) {
     EXPECT_TRUE(named(o, e)) << e.effect << " on " << e.channel << " not named";
     const bool d = e.channel == "D";
@@ -259,6 +263,44 @@ void stress_coupling(plant::PlantConfig& p, plant::ExcitationConfig&) {
   p.stress.d_coefficient_per_pa = 4e-9;
   p.stress.hysteresis_coefficient_per_pa = 0.0;
   p.stress.permittivity_coefficient_per_pa = 0.0;
+}
+
+// Charge drive (D imposed, E sensed) on a free sample, as a disc on a charge bench, without
+// hysteresis (so the charge-drive structure, linear in D, is exact for the clean sample): the
+// base model is identified without electrostriction; with it, the strain follows the square of
+// the imposed polarization.
+TEST(ConcealedEffectChargeDrive, ElectrostrictionIsNamedOnTheStrain) {
+  plant::PlantConfig config = base_plant();
+  config.hysteresis.enabled = false;
+  plant::ExcitationConfig fit_x = fitting_excitation();
+  plant::ExcitationConfig val_x = validation_excitation();
+  free_stack(config, fit_x);
+  free_stack(config, val_x);
+  const Recorded clean = record(config, fit_x, 11);
+  const models::Structure structure = models::Structure::kChargeDrive;
+  const models::TransducerModel base =
+      identification::identify({clean.d, clean.e, {}, clean.s, 1.0 / kRate}, structure,
+                               identification::defaults_for(structure));
+  config.electrostriction.enabled = true;
+  config.electrostriction.q_m4_per_c2 = 0.02;
+  const Recorded fit = record(config, fit_x, 21);
+  const Recorded val = record(config, val_x, 22);
+  const auto charge_drive = [](const Recorded& r) {
+    return diagnosis::Signals{r.d, r.e, r.s, {}, {}, 1.0 / kRate};
+  };
+  const diagnosis::Result result = diagnosis::diagnose(base, charge_drive(fit));
+  ASSERT_FALSE(result.findings.empty());
+  const diagnosis::Finding& first = result.findings.front();
+  EXPECT_EQ(first.effect, "electrostriction");
+  EXPECT_EQ(first.channel, "S");
+  // The evidence names its coefficients as numbers (no format directive left in the text).
+  EXPECT_NE(first.evidence.find("D^3"), std::string::npos) << first.evidence;
+  EXPECT_EQ(first.evidence.find("3g"), std::string::npos) << first.evidence;
+  const double before = nrmse(val.s, diagnosis::simulate(base, charge_drive(val)).strain);
+  const double after = nrmse(val.s, diagnosis::simulate(result.improved, charge_drive(val)).strain);
+  std::printf("[charge drive electrostriction] %s; validation S %.3g %% -> %.3g %%\n",
+              first.evidence.c_str(), 100 * before, 100 * after);
+  EXPECT_LE(after, 0.5 * before);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -310,15 +352,25 @@ INSTANTIATE_TEST_SUITE_P(
              {{"asymmetric_hysteresis", "D"}, {"asymmetric_hysteresis", "S"}},
              true,
              false},
+        // The same stack with a symmetric loop and a flat bias density (the Preisach plane
+        // uniform along the bias: the Prandtl-Ishlinskii class): plays of the drive model it.
+        Case{"hysteresis",
+             [](plant::PlantConfig& p, plant::ExcitationConfig&) {
+               p.hysteresis.enabled = true;
+               p.hysteresis.d_amplitude_c_per_m2 *= 0.1;
+               p.hysteresis.s_amplitude *= 0.1;
+               p.hysteresis.asymmetry = 0.0;
+               p.hysteresis.bias_sigma_v_per_m = 2.5e6;
+             },
+             {{"hysteresis", "D"}, {"hysteresis", "S"}},
+             true,
+             false},
         Case{"electrostriction",
              [](plant::PlantConfig& p, plant::ExcitationConfig&) {
                p.electrostriction.enabled = true;
                p.electrostriction.q_m4_per_c2 = 0.02;
              },
-             // Under unipolar drive S ~ P^2 is a smooth function of the hysteretic polarization,
-             // which hinges on the plays (the Preisach class) also represent: either is named,
-             // with the other among its alternatives.
-             {{"electrostriction", "S", "asymmetric_hysteresis"}}},
+             {{"electrostriction", "S"}}},
         Case{"leakage_and_creep",
              [](plant::PlantConfig& p, plant::ExcitationConfig& x) {
                leakage(p, x);

@@ -29,6 +29,7 @@ ChannelCorrection sensed_correction() {
   c.temperature_drive_per_k = 1e-11;
   c.drive_quadratic = 1e-15;
   c.drive_cubic = -2e-22;
+  c.drive_linear = 3e-10;  // the linear play of hysteresis
   c.leakage_tau_s = 0.5;
   c.delay_s = 3.5 * kTs;
   c.hysteresis_thresholds = {2e5, 5e5};  // hysteresis and asymmetric_hysteresis
@@ -106,9 +107,10 @@ TEST(ChannelCorrection, ForwardCorrectionChangesTheOutputAsWritten) {
   }
 }
 
-// The play terms by their definition: sum w_i (p_i - x) + sum c_h max(0, p_{r_h} - b_h).
+// The play terms by their definition: w_0 x + sum w_i (p_i - x) + sum c_h max(0, p_{r_h} - b_h).
 TEST(ChannelCorrection, PlayTermsAddWhatTheirDefinitionSays) {
   ChannelCorrection c;
+  c.drive_linear = 0.7;
   c.hysteresis_thresholds = {0.1, 0.3};
   c.hysteresis_weights = {2.0, -0.5};
   c.hinge_thresholds = {0.0, 0.3};
@@ -122,8 +124,8 @@ TEST(ChannelCorrection, PlayTermsAddWhatTheirDefinitionSays) {
     if (k == 0) p1 = p3 = x;
     p1 = std::min(std::max(p1, x - 0.1), x + 0.1);
     p3 = std::min(std::max(p3, x - 0.3), x + 0.3);
-    const double expected = 2.0 * (p1 - x) - 0.5 * (p3 - x) + 1.5 * std::max(x - 0.4, 0.0) +
-                            3.0 * std::max(p3 - 0.2, 0.0);
+    const double expected = 0.7 * x + 2.0 * (p1 - x) - 0.5 * (p3 - x) +
+                            1.5 * std::max(x - 0.4, 0.0) + 3.0 * std::max(p3 - 0.2, 0.0);
     CorrectionStage::Inputs in;
     in.y = 0.25;
     in.response = 0.25;
@@ -135,6 +137,35 @@ TEST(ChannelCorrection, PlayTermsAddWhatTheirDefinitionSays) {
   std::string why;
   EXPECT_FALSE(unknown.is_valid("corrections.sensed", &why));
   EXPECT_NE(why.find("corrections.sensed.hinge_thresholds[0]"), std::string::npos) << why;
+}
+
+// Electrostriction: S gains Q P^2 with P the model's sensed response to the drive alone,
+// D - d T (the stress part of D is no polarization), in the simulation and the reconstruction.
+TEST(ChannelCorrection, ElectrostrictionReadsTheSensedResponseWithoutTheStressPart) {
+  TransducerModel base = test::typical_transducer(kTs);
+  base.sensed_correction.reset();
+  base.strain_correction.reset();
+  TransducerModel with = base;
+  ChannelCorrection c;
+  c.sensed_quadratic = 0.02;
+  with.strain_correction = c;
+  const double d = base.sensor->linear_gains.front();
+  ASSERT_NE(d, 0.0);
+  Simulation a(base);
+  Simulation b(with);
+  Reconstruction rec(with);
+  Reconstruction rec_base(base);
+  for (int k = 0; k < 300; ++k) {
+    const double e = 1e6 + 8e5 * std::sin(0.03 * k);
+    const double t = -2e7 + 1e7 * std::sin(0.011 * k);
+    const Simulation::Output plain = a.step(e, t);
+    const double p = plain.sensed - d * t;
+    const Simulation::Output out = b.step(e, t);
+    ASSERT_NEAR(out.strain, plain.strain + 0.02 * p * p, 1e-12) << k;
+    const double s_hat = rec.step(e, out.sensed).strain;
+    const Reconstruction::Estimate plain_hat = rec_base.step(e, plain.sensed);
+    ASSERT_NEAR(s_hat, plain_hat.strain + 0.02 * p * p, 1e-9) << k;
+  }
 }
 
 TEST(ChannelCorrection, StateSavedAndRestoredContinuesBitIdentically) {

@@ -39,11 +39,18 @@ struct Signals {
 };
 
 struct Options {
-  double min_explains{0.3};       // share of held-out residual variance an effect must remove
-  double min_share{0.02};         // ... and at least this share of the channel's first residual
+  double min_explains{0.3};  // share of held-out residual variance an effect must remove
+  double min_share{0.02};    // ... and at least this share of the channel's first residual
+  // ... and in no held-out block may it add more than this share to the residual variance.
+  double max_block_loss{0.2};
   double alternative_share{0.8};  // alternatives: explain at least this share of the best's
   // A simpler candidate wins when the residual it leaves is at most this factor of the best's.
   double parsimony_ratio{1.25};
+  // A hysteresis operator (generic: it bends to many residuals) is chosen over significant
+  // specific physics only when the residual it leaves is at most this factor of theirs.
+  double generic_ratio{0.5};
+  // A candidate whose fit rescales the model's output by more than this (relative) is not one.
+  double max_gain{1.0};
   std::size_t max_effects{4};  // per channel
   std::size_t blocks{10};      // alternate blocks for fitting and judging
 };

@@ -40,7 +40,7 @@ struct CorrectionSignals {
   std::span<const double> drive{};        // x
   std::span<const double> stress{};       // T [Pa]; empty: 0
   std::span<const double> temperature{};  // [degC]; empty: the reference
-  std::span<const double> sensed{};       // the model's sensed output; empty: 0
+  std::span<const double> sensed{};       // the model's sensed response D - d T; empty: 0
   std::span<const double> response{};     // y - coupling T; empty: y
   double sample_time{0.0};                // [s]
   double temperature_reference_degc{25.0};
@@ -54,7 +54,8 @@ struct CorrectionFit {
 
 // Fits the given terms; `start` carries filter parameters already chosen (they are kept, not
 // searched again) and is otherwise ignored. fit_rows[k]: sample k may be used for fitting.
-// Throws std::invalid_argument on mismatched sizes or no fitting rows.
+// Throws std::invalid_argument on mismatched sizes, no fitting rows, no finite fit, or a fit
+// that needs 1 + gain <= 0 (the model's output inverted: not a correction of it).
 [[nodiscard]] CorrectionFit fit_correction(const CorrectionSignals& signals,
                                            std::span<const CorrectionTerm> terms,
                                            const models::ChannelCorrection& start,

@@ -7,9 +7,13 @@
 //         + temperature_drive (theta - theta_ref) x
 //         + stress_gain T r + stress_quadratic T^2               stress_dependence
 //         + drive_quadratic x^2 + drive_cubic x^3                permittivity_nonlinearity
-//         + sensed_quadratic s^2                                 electrostriction (S ~ P^2, P ~ D)
+//         + sensed_quadratic s^2                                 electrostriction (S ~ P^2,
+//                                                                P ~ D - d T)
 //         + sum_j creep_weights_j (z_j - r_0)                    creep (eq. 28: K = L[H])
-//         + sum_i hysteresis_weights_i (p_i - x)                 hysteresis (plays of the drive)
+//         + drive_linear x + sum_i hysteresis_weights_i (p_i - x)
+//                                                                hysteresis (a PI operator of
+//                                                                the drive: its linear play and
+//                                                                the plays p_i)
 //         + sum_h hinge_weights_h max(0, p_{r_h} - b_h)          asymmetric_hysteresis (hinges
 //                                                                on the plays: the Preisach class)
 //   p_i[k] = max(x[k] - r_i, min(x[k] + r_i, p_i[k-1])),  p_i = x at the start (p_0 = x)
@@ -20,7 +24,8 @@
 //       start                                                     charge_leakage
 //   out[k] = m(k Ts - delay)  (linear interpolation, delay <= 64 samples)        delay
 // x: the drive (E for field drive), T: stress [Pa], theta: temperature [degC], s: the model's
-// sensed output (D), r = y - coupling T the channel's response to the drive alone (so a coupling
+// sensed response to the drive alone (D - d T, d the sensor's coupling), r = y - coupling T the
+// channel's response to the drive alone (so a coupling
 // that changes with stress, d(T) = d (1 + k T), is k T r on S and d k T^2 on D). Units: gain,
 // temperature_gain [1/K], stress_gain [1/Pa] relative; offset and the polynomial terms in the
 // channel's unit.
@@ -56,6 +61,7 @@ struct ChannelCorrection {
   double stress_quadratic_per_pa2{0.0};
   double drive_quadratic{0.0};
   double drive_cubic{0.0};
+  double drive_linear{0.0};  // the PI operator's linear play (hysteresis)
   double sensed_quadratic{0.0};
   std::vector<double> creep_eigenvalues{};  // [1/s]
   std::vector<double> creep_weights{};
@@ -91,7 +97,7 @@ class CorrectionStage {
     double drive{0.0};        // x
     double stress{0.0};       // T [Pa]
     double temperature{0.0};  // [degC]
-    double sensed{0.0};       // the model's sensed output (electrostriction term)
+    double sensed{0.0};       // the model's sensed response D - d T (electrostriction term)
     double response{0.0};     // y - coupling T (stress term)
   };
 

@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""clang-tidy over the project's translation units, skipping those already found clean.
+
+Usage: tidy_cached.py BUILD_DIR REGEX [JOBS]
+
+A unit is skipped when the same clang-tidy, the same .clang-tidy, the same compile command and
+the same preprocessed source (every header it includes, the root path written as @ROOT@ so a
+clone elsewhere hits too) were found clean before. Only clean results are cached: a unit with a
+finding runs again next time. Cache: $SELFSENSE_TIDY_CACHE, else /var/cache/selfsense-tidy when
+writable, else BUILD_DIR/tidy-cache. Exit 1 when any unit has a finding (its output is printed).
+"""
+import concurrent.futures
+import hashlib
+import json
+import os
+import re
+import shlex
+import subprocess
+import sys
+
+
+def cache_dir(build):
+    wanted = os.environ.get("SELFSENSE_TIDY_CACHE")
+    candidates = [wanted] if wanted else ["/var/cache/selfsense-tidy"]
+    candidates.append(os.path.join(build, "tidy-cache"))
+    for path in candidates:
+        try:
+            os.makedirs(path, exist_ok=True)
+            if os.access(path, os.W_OK):
+                return path
+        except OSError:
+            continue
+    sys.exit("tidy_cached: no writable cache directory")
+
+
+def preprocess_command(entry):
+    args = entry["arguments"] if "arguments" in entry else shlex.split(entry["command"])
+    out = []
+    skip = False
+    for a in args:
+        if skip:
+            skip = False
+            continue
+        if a == "-o":
+            skip = True
+            continue
+        if a == "-c":
+            continue
+        out.append(a)
+    return out + ["-E", "-P", "-o", "-"]
+
+
+def main():
+    build, pattern = sys.argv[1], re.compile(sys.argv[2])
+    jobs = int(sys.argv[3]) if len(sys.argv) > 3 else os.cpu_count() or 1
+    root = os.path.abspath(os.path.join(build, ".."))
+    with open(os.path.join(build, "compile_commands.json"), encoding="utf-8") as f:
+        entries = [e for e in json.load(f) if pattern.search(e["file"])]
+    cache = cache_dir(build)
+    version = subprocess.run(["clang-tidy", "--version"], capture_output=True, check=True).stdout
+    with open(os.path.join(root, ".clang-tidy"), "rb") as f:
+        config = f.read()
+    root_bytes = root.encode()
+
+    def check(entry):
+        pre = subprocess.run(preprocess_command(entry), cwd=entry["directory"],
+                             capture_output=True)
+        key = hashlib.sha256(version + config)
+        if pre.returncode == 0:
+            command = " ".join(preprocess_command(entry)).encode()
+            key.update(command.replace(root_bytes, b"@ROOT@"))
+            key.update(pre.stdout.replace(root_bytes, b"@ROOT@"))
+            stamp = os.path.join(cache, key.hexdigest())
+            if os.path.exists(stamp):
+                return "cached", ""
+        else:
+            stamp = None  # not preprocessable here: always checked
+        run = subprocess.run(["clang-tidy", "-p", build, "--quiet", entry["file"]],
+                             capture_output=True, text=True)
+        output = run.stdout + run.stderr
+        clean = run.returncode == 0 and not re.search(r"(warning|error):", output)
+        if not clean:
+            return "finding", output or f"clang-tidy exited {run.returncode}"
+        if stamp:
+            with open(stamp, "w", encoding="utf-8"):
+                pass
+        return "checked", ""
+
+    counts = {"cached": 0, "checked": 0, "finding": 0}
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        for outcome, output in pool.map(check, entries):
+            counts[outcome] += 1
+            if output:
+                print(output)
+    print(f"clang-tidy: {len(entries)} units, {counts['checked']} checked, "
+          f"{counts['cached']} clean before (cache {cache}), {counts['finding']} with findings")
+    return 1 if counts["finding"] else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
