@@ -3,7 +3,7 @@
 
 Usage: tidy_cached.py BUILD_DIR REGEX [JOBS]
 
-A unit is skipped when the same clang-tidy, the same .clang-tidy, the same compile command and
+A unit is skipped when the same clang-tidy, the same .clang-tidy files, the same compile command and
 the same preprocessed source (every header it includes, the root path written as @ROOT@ so a
 clone elsewhere hits too) were found clean before. Only clean results are cached: a unit with a
 finding runs again next time. Cache: $SELFSENSE_TIDY_CACHE, else /var/cache/selfsense-tidy when
@@ -58,8 +58,16 @@ def main():
         entries = [e for e in json.load(f) if pattern.search(e["file"])]
     cache = cache_dir(build)
     version = subprocess.run(["clang-tidy", "--version"], capture_output=True, check=True).stdout
-    with open(os.path.join(root, ".clang-tidy"), "rb") as f:
-        config = f.read()
+    config = b""  # every .clang-tidy of the sources (a unit's own and its parents')
+    found = []
+    for base, dirs, files in os.walk(root):
+        dirs[:] = [d for d in dirs if d in ("src", "tests", "drivers", "include")
+                   or os.path.relpath(base, root) != "."]
+        if ".clang-tidy" in files:
+            found.append(os.path.join(base, ".clang-tidy"))
+    for path in sorted(found):
+        with open(path, "rb") as f:
+            config += os.path.relpath(path, root).encode() + b"\0" + f.read()
     root_bytes = root.encode()
 
     def check(entry):

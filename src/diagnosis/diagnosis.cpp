@@ -40,7 +40,9 @@ const std::vector<Candidate>& candidates() {
        Needs::kNothing},
       {"delay", {CorrectionTerm::kDelay}, true, true, Needs::kNothing},
       {"dynamics", {CorrectionTerm::kDynamics}, false, true, Needs::kNothing},
-      {"creep", {CorrectionTerm::kCreep, CorrectionTerm::kOffset}, false, true, Needs::kNothing},
+      // On the sensed channel the lags follow its response to the drive alone (D - d T), which
+      // the reconstruction knows before the measurement (affine models).
+      {"creep", {CorrectionTerm::kCreep, CorrectionTerm::kOffset}, true, true, Needs::kNothing},
       {"hysteresis",
        {CorrectionTerm::kHysteresis, CorrectionTerm::kOffset},
        true,
@@ -134,7 +136,8 @@ struct ChannelData {
   std::span<const double> recorded;
   std::vector<double> base;
   double coupling{0.0};                    // of the stress in the model's side
-  std::span<const double> sensed_model{};  // the model's sensed output (electrostriction)
+  std::span<const double> sensed_model{};  // the model's sensed response (electrostriction)
+  bool affine{true};  // not the stress-hysteresis model: the response is G[x] + y0
 };
 
 // Which samples fit and which judge: sample k lies in block (k blocks) / n; even blocks fit,
@@ -414,6 +417,7 @@ bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, boo
   // T^2 on the sensed channel is solved with the sensor coupling; leakage is a charge's.
   if (uses(CorrectionTerm::kStressQuadratic) && ch.coupling == 0.0) return false;
   if (uses(CorrectionTerm::kLeakage) && charge_drive) return false;
+  if (uses(CorrectionTerm::kCreep) && ch.sensed && !ch.affine) return false;
   switch (c.needs) {
     case Needs::kTemperature:
       return range_of(s.temperature) > 1.0;
@@ -427,6 +431,22 @@ bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, boo
       return true;
   }
   return true;
+}
+
+// Creep keeps moving in the direction of the last step: each lag of the creep operator has a
+// non-negative weight (eq. 28). A fit whose lags pull against the step by more than a quarter of
+// what they push with is something else a lag bank can imitate (charge leakage, a rate effect
+// under periodic drive), not creep.
+bool creep_moves_with_the_step(const ChannelCorrection& c) {
+  double with = 0.0;
+  double against = 0.0;
+  for (const double w : c.creep_weights)
+    (w >= 0.0 ? with : against) += std::abs(w);
+  return against <= 0.25 * with;
+}
+
+bool uses_creep(const Candidate& c) {
+  return std::find(c.terms.begin(), c.terms.end(), CorrectionTerm::kCreep) != c.terms.end();
 }
 
 // The candidate brings a filter whose parameters are not chosen yet.
@@ -539,6 +559,7 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
       } catch (const std::invalid_argument&) {
         continue;  // no finite fit in this stretch
       }
+      if (uses_creep(c) && !creep_moves_with_the_step(local.correction)) continue;
       const double after = segment_sse(ch.recorded, local.output, seg);
       const double bic = seg_n * std::log(std::max(after, 1e-300) / before) +
                          static_cast<double>(complexity(c.terms)) * std::log(seg_n);
@@ -622,8 +643,13 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
 
   std::vector<ChannelData> channels;
   if (has_sensor && !s.sensed.empty()) {
-    channels.push_back(
-        {field ? "D" : "E", true, s.sensed, outputs.sensed, coupling_of(model.sensor)});
+    channels.push_back({field ? "D" : "E",
+                        true,
+                        s.sensed,
+                        outputs.sensed,
+                        coupling_of(model.sensor),
+                        {},
+                        !model.vectorial.has_value()});
   }
   if (has_actuator && !s.strain.empty()) {
     channels.push_back({"S", false, s.strain, outputs.strain, coupling_of(model.actuator)});
@@ -707,6 +733,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
           // A correction that must rescale the model's own output by more than 100 % is a
           // different model, not physics the model left out (re-identify instead).
           if (std::abs(fit.correction.gain) > options.max_gain) continue;
+          if (uses_creep(c) && !creep_moves_with_the_step(fit.correction)) continue;
           const double sse = sse_over(ch.recorded, fit.output, rows.judge);
           const BlockShares shares = block_explains(ch.recorded, current, fit.output, rows);
           tried.push_back({&c, std::move(fit), 1.0 - sse / current_sse, shares});

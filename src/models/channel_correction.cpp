@@ -113,11 +113,6 @@ bool ChannelCorrection::invertible(const std::string& prefix, std::string* why) 
                          ".stress_gain_per_pa: the sensed channel then depends on T "
                          "nonlinearly; reconstruction has no closed-form inverse");
   }
-  if (!creep_weights.empty()) {
-    return fail(why, prefix +
-                         ".creep_weights: creep of the sensed output is not invertible in "
-                         "closed form; identify a hysteresis-creep model instead");
-  }
   if (dynamics_frequency_hz != 0.0) {
     return fail(why, prefix +
                          ".dynamics_frequency_hz: dynamics on the sensed channel are not "
@@ -298,8 +293,18 @@ double CorrectionStage::invert(double measured, const Inputs& in) noexcept {
     m_ = measured;  // the forward's first output is its input: the inverse's too
     w_prev_ = w;
   }
+  if (!started_) {
+    y0_ = in.response;
+    for (std::size_t j = 0; j < creep_count_; ++j)
+      z_[j] = in.response;
+  }
   started_ = true;
-  return (w - terms(in) - play_terms(in.drive)) / gain_at(in);
+  double creep = 0.0;  // lags of the response to the drive alone: known before y is
+  for (std::size_t j = 0; j < creep_count_; ++j) {
+    z_[j] += alpha_[j] * (in.response - z_[j]);
+    creep += c_.creep_weights[j] * (z_[j] - y0_);
+  }
+  return (w - terms(in) - play_terms(in.drive) - creep) / gain_at(in);
 }
 
 double CorrectionStage::solve_stress(double t_lin, double coupling,

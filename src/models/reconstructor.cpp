@@ -85,8 +85,9 @@ Reconstructor::Reconstructor(const TransducerModel& model)
   }
 }
 
-Reconstructor::Estimate Reconstructor::step(double drive, double sensed) noexcept {
-  Estimate out{(sensed - sensor_->step_unloaded(drive)) / sensor_->coupling(), kNaN};
+Reconstructor::Estimate Reconstructor::finish(double drive, double sensed,
+                                              double response) noexcept {
+  Estimate out{(sensed - response) / sensor_->coupling(), kNaN};
   if (actuator_) out.strain = actuator_->step_unloaded(drive) + actuator_->coupling() * out.stress;
   return out;
 }

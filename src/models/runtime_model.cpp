@@ -271,6 +271,12 @@ Reconstruction::Reconstruction(const TransducerModel& model, const RuntimeOption
   if (model.sensed_correction && !model.sensed_correction->invertible("corrections.sensed", &why)) {
     throw std::invalid_argument(why);
   }
+  if (model.sensed_correction && !model.sensed_correction->creep_weights.empty() &&
+      model.vectorial) {
+    throw std::invalid_argument(
+        "corrections.sensed.creep_weights: creep of the sensed channel follows the sensor's "
+        "response to the drive alone, which the stress-hysteresis model does not separate");
+  }
   if (model.sensed_correction && model.sensed_correction->stress_quadratic_per_pa2 != 0.0 &&
       sensed_coupling_ == 0.0) {
     throw std::invalid_argument(
@@ -296,13 +302,17 @@ Reconstruction::Estimate Reconstruction::step(double drive, double sensed) noexc
 Reconstruction::Estimate Reconstruction::kernel_step(double drive, double sensed) noexcept {
   double x = drive;
   double y = sensed;
+  auto* affine = std::get_if<Affine>(&impl_);
+  double response = 0.0;  // G_s[x] + y0_s, when the sensed correction's creep follows it
+  const bool split = sensed_fix_ && sensed_fix_->reads_response() && affine != nullptr;
   if (sensed_fix_) {
     x = sensed_fix_->delay_drive(drive);
-    y = sensed_fix_->invert(sensed, {0.0, x, 0.0, temperature_, 0.0});
+    if (split) response = affine->sensed_response(x);
+    y = sensed_fix_->invert(sensed, {0.0, x, 0.0, temperature_, 0.0, response});
   }
   Estimate out{};
-  if (auto* affine = std::get_if<Affine>(&impl_)) {
-    const Reconstructor::Estimate e = affine->step(x, y);
+  if (affine != nullptr) {
+    const Reconstructor::Estimate e = split ? affine->finish(x, y, response) : affine->step(x, y);
     out = {e.stress, e.strain, SampleStatus::kOk};
   } else {
     const StressHysteresisReconstructor::Estimate e = std::get<Vectorial>(impl_)->step(x, y);

@@ -29,7 +29,9 @@ ChannelCorrection sensed_correction() {
   c.temperature_drive_per_k = 1e-11;
   c.drive_quadratic = 1e-15;
   c.drive_cubic = -2e-22;
-  c.drive_linear = 3e-10;  // the linear play of hysteresis
+  c.drive_linear = 3e-10;              // the linear play of hysteresis
+  c.creep_eigenvalues = {200.0, 5.0};  // lags of the sensor's response to the drive alone
+  c.creep_weights = {0.02, -0.01};
   c.leakage_tau_s = 0.5;
   c.delay_s = 3.5 * kTs;
   c.hysteresis_thresholds = {2e5, 5e5};  // hysteresis and asymmetric_hysteresis
@@ -65,8 +67,8 @@ TransducerModel corrected_model() {
 }
 
 // The reconstruction undoes what the simulation added on the sensed channel: from the
-// simulated D (leakage, delay, gain, offset, temperature, polynomial) it recovers the stress
-// that drove the simulation, a delay later.
+// simulated D (leakage, delay, gain, offset, temperature, polynomial, plays, creep) it recovers
+// the stress that drove the simulation, a delay later.
 TEST(ChannelCorrection, ReconstructionInvertsTheSensedCorrection) {
   TransducerModel m = corrected_model();
   m.strain_correction.reset();
@@ -277,14 +279,15 @@ TEST(ChannelCorrection, BadValuesAreNamedByKey) {
 TEST(ChannelCorrection, ReconstructionRefusesASensedCorrectionWithoutInverse) {
   TransducerModel m = test::typical_transducer(kTs);
   ChannelCorrection c;
-  c.creep_eigenvalues = {1.0};
-  c.creep_weights = {0.01};
+  c.dynamics_frequency_hz = 900.0;
+  c.dynamics_damping = 0.1;
   m.sensed_correction = c;
   try {
     Reconstruction rec(m);
     FAIL() << "accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("corrections.sensed.creep_weights"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("corrections.sensed.dynamics_frequency_hz"),
+              std::string::npos);
   }
   EXPECT_NO_THROW(Simulation sim(m));
 }

@@ -32,11 +32,13 @@
 //
 // Reconstruction needs the inverse on the sensed channel: the leakage is undone
 // (w[k] = w[k-1] + (m[k] - g m[k-1]) / c), a delay moves to the drive, and the additive and
-// gain terms that do not depend on T (the play terms depend on the drive alone) are solved for y;
-// stress_quadratic is solved with the sensor coupling d after the kernel: d T + q' T^2 = d T_lin
-// (q' = q / (1 + gain terms)). Terms that depend on T or on y's history (stress_gain, creep,
-// dynamics) make the sensor side non-invertible in closed form: invertible() says so and the
-// Reconstruction refuses such a model by name.
+// gain terms that do not depend on T (the play terms depend on the drive alone; the creep lags
+// follow the response r = y - d T, which for the affine models is G_s[x] + y0_s, known from the
+// drive before y: the caller passes it) are solved for y; stress_quadratic is solved with the
+// sensor coupling d after the kernel: d T + q' T^2 = d T_lin (q' = q / (1 + gain terms)). Terms
+// that depend on T or on y's own history (stress_gain, dynamics) make the sensor side
+// non-invertible in closed form: invertible() says so and the Reconstruction refuses such a
+// model by name.
 //
 // Real-time safe after construction: step(), invert(), save/restore are noexcept and allocate
 // nothing.
@@ -108,8 +110,9 @@ class CorrectionStage {
   // Forward: the corrected output for this sample.
   double step(const Inputs& in) noexcept;
   // Sensed-channel inverse (only for invertible() corrections): the model output y that
-  // explains the measurement `measured` at this sample; `in.y` is ignored and the drive must
-  // already be delayed by the caller (delay_samples()).
+  // explains the measurement `measured` at this sample; `in.y` is ignored, the drive must
+  // already be delayed by the caller (delay_samples()) and, with creep terms, `in.response` is
+  // the sensor's response to that drive alone.
   double invert(double measured, const Inputs& in) noexcept;
   // After the kernel: the stress that solves the stress_quadratic term, from the kernel's
   // T_lin and the sensor coupling d (T_lin itself without the term).
@@ -118,6 +121,8 @@ class CorrectionStage {
   double delay_drive(double drive) noexcept;
 
   [[nodiscard]] const ChannelCorrection& correction() const noexcept { return c_; }
+  // The inverse reads Inputs::response (creep terms).
+  [[nodiscard]] bool reads_response() const noexcept { return creep_count_ > 0; }
   [[nodiscard]] static constexpr std::size_t state_size() noexcept { return kStateSize; }
   void save_state(std::span<double> out) const noexcept;
   void restore_state(std::span<const double> in) noexcept;

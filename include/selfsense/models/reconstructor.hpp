@@ -76,7 +76,15 @@ class Reconstructor final {
   // Throws std::invalid_argument if the model has no sensor side or a zero sensor coupling
   // (then the measured charge says nothing about stress).
   explicit Reconstructor(const TransducerModel& model);
-  Estimate step(double drive, double sensed) noexcept;
+  Estimate step(double drive, double sensed) noexcept {
+    return finish(drive, sensed, sensed_response(drive));
+  }
+  // The same step in two phases, for a sensed-channel correction that reads the sensor's
+  // response to the drive alone (creep of that response, channel_correction.hpp):
+  // sensed_response(x) = G_s[x] + y0_s advances the sensor operator; finish() takes the measured
+  // y and that response and advances the actuator side.
+  double sensed_response(double drive) noexcept { return sensor_->step_unloaded(drive); }
+  Estimate finish(double drive, double sensed, double response) noexcept;
   [[nodiscard]] std::optional<SideOperator>& sensor() noexcept { return sensor_; }
   [[nodiscard]] std::optional<SideOperator>& actuator() noexcept { return actuator_; }
   [[nodiscard]] const std::optional<SideOperator>& sensor() const noexcept { return sensor_; }
