@@ -358,7 +358,7 @@ struct Solved {
   double sse{std::numeric_limits<double>::infinity()};
 };
 
-Solved solve(std::span<const double> target, const std::vector<std::vector<double>>& columns,
+Solved solve(std::span<const double> target, std::span<const std::span<const double>> columns,
              const std::vector<bool>& rows) {
   const auto p = static_cast<Eigen::Index>(columns.size());
   Eigen::MatrixXd g = Eigen::MatrixXd::Zero(p, p);
@@ -436,17 +436,29 @@ CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const Correct
   Solved best;
   ChannelCorrection best_filters;
   const auto evaluate = [&](const ChannelCorrection& filters) {
+    // Unfiltered columns are read in place (a 1e6-sample recording: no copies per evaluation).
     const bool any_filter = !filters.empty();
-    std::vector<std::vector<double>> cols;
+    std::vector<std::vector<double>> owned;
+    std::vector<std::span<const double>> cols;
     cols.reserve(columns.phi.size());
+    if (any_filter) owned.reserve(columns.phi.size());
     for (const std::vector<double>& phi : columns.phi) {
-      cols.push_back(any_filter ? filtered(phi, filters, s.sample_time) : phi);
+      if (any_filter) {
+        owned.push_back(filtered(phi, filters, s.sample_time));
+        cols.emplace_back(owned.back());
+      } else {
+        cols.emplace_back(phi);
+      }
     }
-    const std::vector<double> fy = any_filter ? filtered(s.y, filters, s.sample_time)
-                                              : std::vector<double>(s.y.begin(), s.y.end());
-    std::vector<double> target(n);
-    for (std::size_t k = 0; k < n; ++k)
-      target[k] = s.recorded[k] - fy[k];
+    std::vector<double> target(s.recorded.begin(), s.recorded.end());
+    if (any_filter) {
+      const std::vector<double> fy = filtered(s.y, filters, s.sample_time);
+      for (std::size_t k = 0; k < n; ++k)
+        target[k] -= fy[k];
+    } else {
+      for (std::size_t k = 0; k < n; ++k)
+        target[k] -= s.y[k];
+    }
     Solved solved = solve(target, cols, fit_rows);
     if (solved.sse < best.sse) {
       best = std::move(solved);
