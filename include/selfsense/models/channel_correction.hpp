@@ -25,10 +25,10 @@
 //   out[k] = m(k Ts - delay)  (linear interpolation, delay <= 64 samples)        delay
 // x: the drive (E for field drive), T: stress [Pa], theta: temperature [degC], s: the model's
 // sensed response to the drive alone (D - d T, d the sensor's coupling), r = y - coupling T the
-// channel's response to the drive alone (so a coupling
-// that changes with stress, d(T) = d (1 + k T), is k T r on S and d k T^2 on D). Units: gain,
-// temperature_gain [1/K], stress_gain [1/Pa] relative; offset and the polynomial terms in the
-// channel's unit.
+// channel's response to the drive alone (so a coupling that changes with stress,
+// d(T) = d (1 + k T), is k T r on S and d k T^2 on D). Units: gain, temperature_gain [1/K],
+// stress_gain [1/Pa] relative; offset, drive_linear and the polynomial terms in the channel's
+// unit (per unit of the drive to its power).
 //
 // Reconstruction needs the inverse on the sensed channel: the leakage is undone
 // (w[k] = w[k-1] + (m[k] - g m[k-1]) / c), a delay moves to the drive, and the additive and
