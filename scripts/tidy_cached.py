@@ -3,9 +3,9 @@
 
 Usage: tidy_cached.py BUILD_DIR REGEX [JOBS]
 
-A unit is skipped when the same clang-tidy, the same .clang-tidy files, the same compile command and
-the same preprocessed source (every header it includes, the root path written as @ROOT@ so a
-clone elsewhere hits too) were found clean before. Only clean results are cached: a unit with a
+A unit is skipped when the same clang-tidy, the same .clang-tidy files, the same compile command
+and the same preprocessed source (every header it includes, the source root written as @ROOT@ so
+a clone elsewhere hits too) were found clean before. Only clean results are cached: a unit with a
 finding runs again next time. Cache: $SELFSENSE_TIDY_CACHE, else /var/cache/selfsense-tidy when
 writable, else BUILD_DIR/tidy-cache. Exit 1 when any unit has a finding (its output is printed).
 """
@@ -53,7 +53,7 @@ def preprocess_command(entry):
 def main():
     build, pattern = sys.argv[1], re.compile(sys.argv[2])
     jobs = int(sys.argv[3]) if len(sys.argv) > 3 else os.cpu_count() or 1
-    root = os.path.abspath(os.path.join(build, ".."))
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # scripts/..
     with open(os.path.join(build, "compile_commands.json"), encoding="utf-8") as f:
         entries = [e for e in json.load(f) if pattern.search(e["file"])]
     cache = cache_dir(build)
