@@ -203,6 +203,15 @@ double sse_over(std::span<const double> recorded, const std::vector<double>& mod
 
 // Non-finite model outputs (a rejected first sample) are held at the last finite value so no
 // filter state sees them; `usable` marks the samples that were finite.
+// A channel's response to the drive alone, r = y - coupling T (y itself without a stress).
+std::vector<double> response_to_drive(std::span<const double> y, double coupling,
+                                      std::span<const double> stress) {
+  std::vector<double> r(y.begin(), y.end());
+  for (std::size_t k = 0; k < stress.size() && k < r.size(); ++k)
+    r[k] -= coupling * stress[k];
+  return r;
+}
+
 std::vector<bool> hold_finite(std::vector<double>& y) {
   std::vector<bool> usable(y.size());
   double last = 0.0;
@@ -408,12 +417,14 @@ double coupling_of(const std::optional<models::SideModel>& side) {
   return (side && !side->linear_gains.empty()) ? side->linear_gains.front() : 0.0;
 }
 
+bool uses_term(const Candidate& c, CorrectionTerm t) {
+  return std::find(c.terms.begin(), c.terms.end(), t) != c.terms.end();
+}
+
 bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, bool has_sensed,
                 bool charge_drive) {
   if (ch.sensed ? !c.on_sensed : !c.on_strain) return false;
-  const auto uses = [&](CorrectionTerm t) {
-    return std::find(c.terms.begin(), c.terms.end(), t) != c.terms.end();
-  };
+  const auto uses = [&](CorrectionTerm t) { return uses_term(c, t); };
   // T^2 on the sensed channel is solved with the sensor coupling; leakage is a charge's.
   if (uses(CorrectionTerm::kStressQuadratic) && ch.coupling == 0.0) return false;
   if (uses(CorrectionTerm::kLeakage) && charge_drive) return false;
@@ -443,10 +454,6 @@ bool creep_moves_with_the_step(const ChannelCorrection& c) {
   for (const double w : c.creep_weights)
     (w >= 0.0 ? with : against) += std::abs(w);
   return against <= 0.25 * with;
-}
-
-bool uses_creep(const Candidate& c) {
-  return std::find(c.terms.begin(), c.terms.end(), CorrectionTerm::kCreep) != c.terms.end();
 }
 
 // The candidate brings a filter whose parameters are not chosen yet.
@@ -559,7 +566,8 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
       } catch (const std::invalid_argument&) {
         continue;  // no finite fit in this stretch
       }
-      if (uses_creep(c) && !creep_moves_with_the_step(local.correction)) continue;
+      if (uses_term(c, CorrectionTerm::kCreep) && !creep_moves_with_the_step(local.correction))
+        continue;
       const double after = segment_sse(ch.recorded, local.output, seg);
       const double bic = seg_n * std::log(std::max(after, 1e-300) / before) +
                          static_cast<double>(complexity(c.terms)) * std::log(seg_n);
@@ -663,12 +671,8 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
   // The channels hold their own copies; the electrostriction term reads the sensed channel's
   // response to the drive alone (D - d T: the polarization and the dielectric part).
   static_cast<void>(hold_finite(outputs.sensed));
-  std::vector<double> sensed_response = outputs.sensed;
-  if (!s.stress.empty()) {
-    const double d = coupling_of(model.sensor);
-    for (std::size_t k = 0; k < n; ++k)
-      sensed_response[k] -= d * s.stress[k];
-  }
+  const std::vector<double> sensed_response =
+      response_to_drive(outputs.sensed, coupling_of(model.sensor), s.stress);
 
   Result result;
   result.improved = base;
@@ -683,11 +687,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     cs.stress = s.stress;
     cs.temperature = s.temperature;
     cs.sensed = has_sensor ? std::span<const double>(sensed_response) : std::span<const double>();
-    std::vector<double> response(ch.base);
-    if (!s.stress.empty()) {
-      for (std::size_t k = 0; k < n; ++k)
-        response[k] -= ch.coupling * s.stress[k];
-    }
+    const std::vector<double> response = response_to_drive(ch.base, ch.coupling, s.stress);
     cs.response = response;
     cs.sample_time = s.sample_time;
     if (!s.temperature.empty()) cs.temperature_reference_degc = s.temperature[0];
@@ -733,7 +733,8 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
           // A correction that must rescale the model's own output by more than 100 % is a
           // different model, not physics the model left out (re-identify instead).
           if (std::abs(fit.correction.gain) > options.max_gain) continue;
-          if (uses_creep(c) && !creep_moves_with_the_step(fit.correction)) continue;
+          if (uses_term(c, CorrectionTerm::kCreep) && !creep_moves_with_the_step(fit.correction))
+            continue;
           const double sse = sse_over(ch.recorded, fit.output, rows.judge);
           const BlockShares shares = block_explains(ch.recorded, current, fit.output, rows);
           tried.push_back({&c, std::move(fit), 1.0 - sse / current_sse, shares});
