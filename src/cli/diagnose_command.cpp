@@ -109,10 +109,12 @@ void run(const DiagnoseOptions& opt) {
   const std::vector<ChannelFigures> after = figures_of(result.improved, rec);
   j["fit"] = {{"before", to_json(before)}, {"after", to_json(after)}};
   ReportInput report;
+  std::vector<ChannelFigures> vb;
+  std::vector<ChannelFigures> va;
   if (!opt.validate.empty()) {
     const FieldSignals val = load_signals(opt.validate, model);
-    const std::vector<ChannelFigures> vb = figures_of(model, val);
-    const std::vector<ChannelFigures> va = figures_of(result.improved, val);
+    vb = figures_of(model, val);
+    va = figures_of(result.improved, val);
     j["validation"] = {{"before", to_json(vb)}, {"after", to_json(va)}};
     report.validation_before = report_figures(vb);
     report.validation_after = report_figures(va);
@@ -200,6 +202,7 @@ void run(const DiagnoseOptions& opt) {
     }
   };
   print("fit", before, after);
+  print("validation", vb, va);
   const double seconds_taken =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::printf("wrote %s, %s, %s (%.1f s)\n", opt.json.string().c_str(), opt.report.string().c_str(),

@@ -312,12 +312,12 @@ void describe(Finding& f, const ChannelCorrection& c, const ChannelData& ch, con
         c.creep_eigenvalues.empty()
             ? 1.0
             : std::max(1.0, std::log10(c.creep_eigenvalues.back() / c.creep_eigenvalues.front()));
+    const std::string span =
+        decades > 1.0 ? format("%.2g decades of lags", decades) : std::string("lags over a decade");
     f.evidence = "after steps of the drive the recorded " + n +
-                 format(
-                     " keeps moving by %.2g %% of the step per decade of time (%.2g decades "
-                     "of lags)",
-                     100.0 * total / decades, decades) +
-                 tail;
+                 format(" keeps moving by %.2g %% of the step per decade of time (",
+                        100.0 * total / decades) +
+                 span + ")" + tail;
     f.feature_name = "log10 time since the drive last stepped [s]";
     f.feature = log_time_since_step(s.drive, s.sample_time);
   } else if (f.effect == "hysteresis" || f.effect == "asymmetric_hysteresis") {
@@ -444,16 +444,32 @@ bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, boo
   return true;
 }
 
-// Creep keeps moving in the direction of the last step: each lag of the creep operator has a
-// non-negative weight (eq. 28). A fit whose lags pull against the step by more than a quarter of
-// what they push with is something else a lag bank can imitate (charge leakage, a rate effect
-// under periodic drive), not creep.
+// Creep keeps moving in the direction of the last step (eq. 28: lags with non-negative weights).
+// The lags' response to a unit step of the model's response, s(t) = sum_j w_j (1 - exp(-l_j t)),
+// must move with the step: never fall back past where it started, and give back at most half of
+// what it gained (a ferroelectric relaxes partly after switching; a lag bank imitating charge
+// leakage, or the phase of a periodic drive, gives it all back or turns against the step).
 bool creep_moves_with_the_step(const ChannelCorrection& c) {
-  double with = 0.0;
-  double against = 0.0;
-  for (const double w : c.creep_weights)
-    (w >= 0.0 ? with : against) += std::abs(w);
-  return against <= 0.25 * with;
+  const auto s = [&](double t) {
+    double sum = 0.0;
+    for (std::size_t j = 0; j < c.creep_weights.size(); ++j)
+      sum += c.creep_weights[j] * -std::expm1(-c.creep_eigenvalues[j] * t);
+    return sum;
+  };
+  if (c.creep_eigenvalues.empty()) return false;
+  const auto [lo, hi] = std::minmax_element(c.creep_eigenvalues.begin(), c.creep_eigenvalues.end());
+  // 20 points per decade from a tenth of the fastest time constant to 100 slowest ones.
+  const double t0 = 0.1 / *hi;
+  const auto points = static_cast<int>(std::ceil(20.0 * std::log10(1000.0 * *hi / *lo)));
+  double peak = 0.0;
+  double lowest = 0.0;
+  for (int i = 0; i <= points; ++i) {
+    const double v = s(t0 * std::pow(10.0, 0.05 * i));
+    peak = std::max(peak, v);
+    lowest = std::min(lowest, v);
+  }
+  const double final_value = s(std::numeric_limits<double>::infinity());
+  return peak > 0.0 && lowest >= -0.05 * peak && final_value >= 0.5 * peak;
 }
 
 // The candidate brings a filter whose parameters are not chosen yet.
@@ -518,6 +534,97 @@ double segment_sse(std::span<const double> recorded, const std::vector<double>& 
 
 bool overlaps(const Segment& a, const Segment& b) {
   return a.begin < b.end && b.begin < a.end;
+}
+
+// Creep lives in the holds after steps; in a record of a few holds that differ (large steps
+// and small ones, switching and none) alternate time blocks judge it on stretches where it
+// barely shows. Then each hold is held out in turn (holds i, i + G, ... together, G <= 8
+// refits): the candidate is refitted on everything else and judged on how the residual moves
+// within the held-out hold (each hold's mean removed: creep is the movement, the level is the
+// static loop's). It passes when it explains at least `min_explains` of that movement over all
+// holds and in two holds or more (not one by chance), and makes no hold worse by more than
+// `max_block_loss` of the larger of that hold's and the mean hold's movement (a hold that
+// hardly moves is judged against the others, not against its own noise).
+struct HoldJudgement {
+  bool passes{false};
+  double explains{0.0};  // of the movement within the held-out holds
+  std::size_t improved{0};
+  std::size_t holds{0};
+};
+
+HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
+                             const std::vector<CorrectionTerm>& terms,
+                             const ChannelCorrection& start, const Rows& rows,
+                             const std::vector<double>& current, const std::vector<Segment>& holds,
+                             const Options& options) {
+  constexpr std::size_t kMaxRefits = 8;
+  HoldJudgement j;
+  j.holds = holds.size();
+  if (holds.size() < 3) return j;
+  const std::size_t n = current.size();
+  const std::size_t groups = std::min(holds.size(), kMaxRefits);
+  std::vector<double> held_out(current);
+  for (std::size_t g = 0; g < groups; ++g) {
+    std::vector<bool> fit_rows(n);
+    for (std::size_t k = 0; k < n; ++k)
+      fit_rows[k] = rows.fit[k] || rows.judge[k];
+    for (std::size_t h = g; h < holds.size(); h += groups) {
+      for (std::size_t k = holds[h].begin; k < holds[h].end; ++k)
+        fit_rows[k] = false;
+    }
+    const identification::CorrectionFit fit =
+        identification::fit_correction(cs, terms, start, fit_rows);
+    for (std::size_t h = g; h < holds.size(); h += groups) {
+      for (std::size_t k = holds[h].begin; k < holds[h].end; ++k)
+        held_out[k] = fit.output[k];
+    }
+  }
+  // Movement within each hold: the residual's variance about its mean in the hold.
+  const auto movement = [&](const std::vector<double>& model, const Segment& h) {
+    double sum = 0.0;
+    double sum2 = 0.0;
+    double count = 0.0;
+    for (std::size_t k = h.begin; k < h.end; ++k) {
+      if (!(rows.fit[k] || rows.judge[k])) continue;
+      const double e = cs.recorded[k] - model[k];
+      sum += e;
+      sum2 += e * e;
+      count += 1.0;
+    }
+    return count > 0.0 ? sum2 - sum * sum / count : 0.0;
+  };
+  std::vector<double> before(holds.size());
+  std::vector<double> after(holds.size());
+  double total_before = 0.0;
+  double total_after = 0.0;
+  for (std::size_t h = 0; h < holds.size(); ++h) {
+    before[h] = movement(current, holds[h]);
+    after[h] = movement(held_out, holds[h]);
+    total_before += before[h];
+    total_after += after[h];
+  }
+  if (!(total_before > 0.0)) return j;
+  const double mean_before = total_before / static_cast<double>(holds.size());
+  double worst = 0.0;
+  for (std::size_t h = 0; h < holds.size(); ++h) {
+    if (before[h] > 0.0 && after[h] <= (1.0 - options.min_explains) * before[h]) ++j.improved;
+    worst = std::max(worst, (after[h] - before[h]) / std::max(before[h], mean_before));
+  }
+  j.explains = 1.0 - total_after / total_before;
+  j.passes =
+      j.explains >= options.min_explains && j.improved >= 2 && worst <= options.max_block_loss;
+  return j;
+}
+
+// How a finding was judged, for its evidence.
+std::string judged_on(const HoldJudgement& holds, const Options& options) {
+  if (!holds.passes) return "on held-out blocks";
+  return format(
+             "on held-out blocks; judged on held-out holds, where it explains %.0f %% of the "
+             "movement within them and more than %.0f %% in %.0f",
+             100.0 * holds.explains, 100.0 * options.min_explains,
+             static_cast<double>(holds.improved)) +
+         format(" of %.0f holds", static_cast<double>(holds.holds));
 }
 
 // Transients the block statistics cannot see (ringing after one fast step is a few samples of a
@@ -674,6 +781,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
   const std::vector<double> sensed_response =
       response_to_drive(outputs.sensed, coupling_of(model.sensor), s.stress);
 
+  const std::vector<Segment> drive_holds = holds_of(s.drive);
   Result result;
   result.improved = base;
   for (ChannelData& ch : channels) {
@@ -705,6 +813,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         identification::CorrectionFit fit;
         double explains;
         BlockShares blocks;  // over the held-out blocks
+        HoldJudgement holds;
       };
       std::vector<Tried> tried;
       for (const Candidate& c : candidates()) {
@@ -736,8 +845,14 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
           if (uses_term(c, CorrectionTerm::kCreep) && !creep_moves_with_the_step(fit.correction))
             continue;
           const double sse = sse_over(ch.recorded, fit.output, rows.judge);
+          const double explains = 1.0 - sse / current_sse;
           const BlockShares shares = block_explains(ch.recorded, current, fit.output, rows);
-          tried.push_back({&c, std::move(fit), 1.0 - sse / current_sse, shares});
+          HoldJudgement holds;
+          if (uses_term(c, CorrectionTerm::kCreep) && explains >= options.min_explains &&
+              !(shares.median >= options.min_explains && shares.worst >= -options.max_block_loss)) {
+            holds = judge_on_holds(cs, terms, start, rows, current, drive_holds, options);
+          }
+          tried.push_back({&c, std::move(fit), explains, shares, holds});
         } catch (const std::invalid_argument&) {
           continue;  // no finite fit of this candidate on these signals: not a candidate here
         }
@@ -746,8 +861,9 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       std::sort(tried.begin(), tried.end(),
                 [](const Tried& a, const Tried& b) { return a.explains > b.explains; });
       const auto significant = [&](const Tried& t) {
-        return t.explains >= options.min_explains && t.blocks.median >= options.min_explains &&
-               t.blocks.worst >= -options.max_block_loss &&
+        const bool in_blocks =
+            t.blocks.median >= options.min_explains && t.blocks.worst >= -options.max_block_loss;
+        return t.explains >= options.min_explains && (in_blocks || t.holds.passes) &&
                t.explains * current_sse >= options.min_share * original_sse;
       };
       // Specific physics first: when one is significant, a generic candidate competes only if
@@ -793,7 +909,8 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         change[k] = best.fit.output[k] - current[k];
       f.where = large_segments(change, 1.5, 5);
       if (f.where.empty()) f.where = {{0, n}};  // spread evenly: the whole record
-      describe(f, best.fit.correction, ch, s, current, best.fit.output);
+      const std::string judged = judged_on(best.holds, options);
+      describe(f, best.fit.correction, ch, s, current, best.fit.output, judged.c_str());
       result.findings.push_back(std::move(f));
 
       accepted_terms = merged(accepted_terms, best.candidate->terms);

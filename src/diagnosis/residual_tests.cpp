@@ -113,4 +113,24 @@ std::vector<Segment> large_segments(std::span<const double> residual, double fac
   return out;
 }
 
+std::vector<Segment> holds_of(std::span<const double> drive) {
+  const std::size_t n = drive.size();
+  if (n == 0) return {};
+  const std::size_t shortest = std::max<std::size_t>(16, n / 100);
+  const auto [lo, hi] = std::minmax_element(drive.begin(), drive.end());
+  const double band = 0.05 * (*hi - *lo);
+  std::vector<Segment> out;
+  std::size_t previous_end = 0;
+  std::size_t begin = 0;  // where the drive last stepped to a new level
+  for (std::size_t k = 1; k <= n; ++k) {
+    if (k < n && std::abs(drive[k] - drive[begin]) <= band) continue;
+    if (k - begin >= shortest) {
+      out.push_back({std::max(previous_end, begin - std::min(begin, shortest)), k});
+      previous_end = k;
+    }
+    begin = k;
+  }
+  return out;
+}
+
 }  // namespace selfsense::diagnosis

@@ -10,7 +10,9 @@
 //      explains = 1 - SSE_after / SSE_before there
 //   3. the best candidate is accepted when it explains at least `min_explains` of the held-out
 //      residual, overall and in the median held-out block (a term that fits one stretch by
-//      chance is not named); of candidates explaining about as much, the simplest wins; candidates
+//      chance is not named); creep, which lives in the holds after steps, may instead pass on
+//      held-out holds (each hold refitted without it: the movement within the holds explained,
+//      in two or more); of candidates explaining about as much, the simplest wins; candidates
 //      that explain nearly as much are reported as alternatives; then the search repeats on what is
 //      left (several effects in turn), refitting the accepted terms jointly with each new candidate
 //   4. the accepted corrections go into the model, which the runtime runs per sample.

@@ -6,6 +6,9 @@
 // Segments: where the moving RMS of the residual (window of 1 % of the record, at least 16
 // samples) exceeds `factor` times the RMS of the whole residual; neighbours closer than a window
 // are merged and the strongest `max_segments` kept, in time order.
+// Holds: stretches of at least 1 % of the record (and 16 samples) in which the drive stays within
+// 5 % of its range of the level it stepped to; the step leading into a hold (a ramp of shorter
+// stretches, at most as long as the shortest hold) belongs to it. A continuous drive has none.
 #pragma once
 
 #include <cstddef>
@@ -34,5 +37,7 @@ struct Segment {
 
 [[nodiscard]] std::vector<Segment> large_segments(std::span<const double> residual, double factor,
                                                   std::size_t max_segments);
+
+[[nodiscard]] std::vector<Segment> holds_of(std::span<const double> drive);
 
 }  // namespace selfsense::diagnosis
