@@ -98,12 +98,17 @@ void run(const DiagnoseOptions& opt) {
     for (const ReportSegment& s : seconds(f.where, rec.t)) {
       where.push_back({{"t_start", s.t_start}, {"t_end", s.t_end}});
     }
+    nlohmann::json alternatives = nlohmann::json::array();
+    for (const diagnosis::Alternative& a : f.alternatives) {
+      alternatives.push_back(
+          {{"effect", a.effect}, {"explains", a.explains}, {"evidence", a.evidence}});
+    }
     j["findings"].push_back({{"effect", f.effect},
                              {"channel", f.channel},
                              {"where", where},
                              {"explains", f.explains},
                              {"evidence", f.evidence},
-                             {"alternatives", f.alternatives}});
+                             {"alternatives", alternatives}});
   }
   const std::vector<ChannelFigures> before = figures_of(model, rec);
   const std::vector<ChannelFigures> after = figures_of(result.improved, rec);
@@ -175,6 +180,8 @@ void run(const DiagnoseOptions& opt) {
     rf.where = seconds(f.where, rec.t);
     rf.explains = f.explains;
     rf.evidence = f.evidence;
+    for (const diagnosis::Alternative& a : f.alternatives)
+      rf.alternatives.push_back({a.effect, a.explains, a.evidence});
     rf.feature_name = f.feature_name;
     rf.feature = f.feature;
     for (const diagnosis::ChannelResult& c : result.channels) {

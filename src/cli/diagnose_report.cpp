@@ -203,8 +203,16 @@ std::string findings_section(const ReportInput& in) {
   out += "</table>\n<ul>\n";
   for (const ReportFinding& f : in.findings) {
     out += "<li><b>" + escape_html(f.effect) + "</b> on " + escape_html(f.channel) + " explains " +
-           percent(f.explains) + " of the residual variance: " + escape_html(f.evidence) +
-           "</li>\n";
+           percent(f.explains) + " of the residual variance: " + escape_html(f.evidence);
+    if (!f.alternatives.empty()) {
+      out += "\n<br>Explaining nearly as much, not told apart by these data:<ul>\n";
+      for (const ReportFinding::Alternative& a : f.alternatives) {
+        out += "<li><b>" + escape_html(a.effect) + "</b> would explain " + percent(a.explains) +
+               ": " + escape_html(a.evidence) + "</li>\n";
+      }
+      out += "</ul>";
+    }
+    out += "</li>\n";
   }
   return out + "</ul>\n</section>\n";
 }

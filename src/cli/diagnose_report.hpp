@@ -37,6 +37,13 @@ struct ReportFinding {
   std::vector<ReportSegment> where{};
   double explains{0.0};  // share of the residual variance removed
   std::string evidence{};
+  // Other effects that explain nearly as much of the same residual, with their evidence.
+  struct Alternative {
+    std::string effect{};
+    double explains{0.0};
+    std::string evidence{};
+  };
+  std::vector<Alternative> alternatives{};
   // Residual (before) against the feature that explains it, for the scatter plot.
   std::string feature_name{};  // e.g. "log10 time since last step [s]"
   std::vector<double> feature{};

@@ -900,8 +900,15 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       // removes, so the shares of several findings add up.
       f.explains = original_sse > 0.0 ? best.explains * current_sse / original_sse : 0.0;
       for (std::size_t i = 1; i < tried.size(); ++i) {
-        if (tried[i].explains >= options.alternative_share * best.explains) {
-          f.alternatives.emplace_back(tried[i].candidate->effect);
+        if (tried[i].explains >= options.alternative_share * best.explains &&
+            significant(tried[i])) {
+          Finding other;
+          other.effect = tried[i].candidate->effect;
+          other.explains =
+              original_sse > 0.0 ? tried[i].explains * current_sse / original_sse : 0.0;
+          describe(other, tried[i].fit.correction, ch, s, current, tried[i].fit.output,
+                   judged_on(tried[i].holds, options).c_str());
+          f.alternatives.push_back({other.effect, other.explains, std::move(other.evidence)});
         }
       }
       std::vector<double> change(n);

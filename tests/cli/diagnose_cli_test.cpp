@@ -80,6 +80,11 @@ TEST_F(DiagnoseCli, NamesModelsAndShowsTheFitImproveOnValidationData) {
     creep |= f.at("effect") == "creep" && f.at("channel") == "S";
     EXPECT_GT(f.at("explains").get<double>(), 0.3);
     EXPECT_FALSE(f.at("evidence").get<std::string>().empty());
+    for (const json& a : f.at("alternatives")) {  // each with its own figure and evidence
+      EXPECT_FALSE(a.at("effect").get<std::string>().empty());
+      EXPECT_GT(a.at("explains").get<double>(), 0.0);
+      EXPECT_FALSE(a.at("evidence").get<std::string>().empty());
+    }
     for (const json& w : f.at("where")) {
       EXPECT_LT(w.at("t_start").get<double>(), w.at("t_end").get<double>());
     }

@@ -98,6 +98,10 @@ TEST_F(DiagnoseReport, HasEverySectionAndPlot) {
   EXPECT_NE(html.find("log10 time since last step [s]"), std::string::npos);
   EXPECT_NE(html.find("data/validation.csv"), std::string::npos);
   EXPECT_NE(html.find("83 %"), std::string::npos);  // explains, as a percentage
+  // An alternative is shown with its own figure and evidence, escaped.
+  EXPECT_NE(html.find("<b>hysteresis</b> would explain 70 %: the recorded S differs on rising "
+                      "&amp; falling branches &lt;here&gt;"),
+            std::string::npos);
   EXPECT_NE(html.find("12 %"), std::string::npos);  // S nrmse before
   // Per channel: one residual plot, two loops, four correlation plots; one scatter per finding.
   EXPECT_EQ(count(html, "<svg"), 2U * 7U + 2U);

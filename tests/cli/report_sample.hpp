@@ -93,6 +93,10 @@ inline cli::ReportInput make_sample_report(std::size_t n) {
     f.where = in.channels[k].located;
     f.explains = 0.83 - 0.2 * static_cast<double>(k);
     f.evidence = "residual rises with log time after each step (r = 0.91 > 0.5 & p < 1e-6)";
+    if (k == 0) {
+      f.alternatives.push_back(
+          {"hysteresis", 0.7, "the recorded S differs on rising & falling branches <here>"});
+    }
     f.feature_name = features[k];
     f.feature.resize(n);
     f.residual.resize(n);

@@ -213,8 +213,9 @@ Outcome run_case(const Case& c) {
   for (const diagnosis::Finding& f : o.result.findings) {
     std::printf("   %s on %s explains %.2f: %s\n", f.effect.c_str(), f.channel.c_str(), f.explains,
                 f.evidence.c_str());
-    for (const std::string& a : f.alternatives)
-      std::printf("     alternative: %s\n", a.c_str());
+    for (const diagnosis::Alternative& a : f.alternatives)
+      std::printf("     alternative: %s (%.2f): %s\n", a.effect.c_str(), a.explains,
+                  a.evidence.c_str());
   }
   return o;
 }
@@ -238,6 +239,13 @@ TEST_P(ConcealedEffect, NamedAndValidationErrorHalved) {
     return;
   }
   EXPECT_TRUE(o.result.mismatch);
+  // Alternatives explain nearly as much (Options::alternative_share) and say why, in numbers.
+  for (const diagnosis::Finding& f : o.result.findings) {
+    for (const diagnosis::Alternative& a : f.alternatives) {
+      EXPECT_GE(a.explains, 0.8 * f.explains - 1e-12) << a.effect;
+      EXPECT_NE(a.evidence.find(" %"), std::string::npos) << a.evidence;
+    }
+  }
   // Named first: the first finding on each affected channel is a planted effect, not physics
   // the planted one merely resembles.
   for (const Expected& e : c.expected) {

@@ -13,8 +13,9 @@
 //      chance is not named); creep, which lives in the holds after steps, may instead pass on
 //      held-out holds (each hold refitted without it: the movement within the holds explained,
 //      in two or more); of candidates explaining about as much, the simplest wins; candidates
-//      that explain nearly as much are reported as alternatives; then the search repeats on what is
-//      left (several effects in turn), refitting the accepted terms jointly with each new candidate
+//      that pass too and explain nearly as much are reported as alternatives, with their own
+//      evidence; then the search repeats on what is left (several effects in turn), refitting
+//      the accepted terms jointly with each new candidate
 //   4. the accepted corrections go into the model, which the runtime runs per sample.
 // A model that already carries corrections is diagnosed from its sides alone (its corrections
 // are found again if still needed).
@@ -57,13 +58,21 @@ struct Options {
   std::size_t blocks{10};      // alternate blocks for fitting and judging
 };
 
+// Another effect that explains nearly as much of the same residual, with its own evidence: the
+// data cannot tell the two apart, so both are reported.
+struct Alternative {
+  std::string effect{};
+  double explains{0.0};
+  std::string evidence{};
+};
+
 struct Finding {
   std::string effect{};   // physics.md word
   std::string channel{};  // "D" / "S" (or "E" for charge drive)
   std::vector<Segment> where{};
   double explains{0.0};
   std::string evidence{};
-  std::vector<std::string> alternatives{};  // other effects explaining nearly as much
+  std::vector<Alternative> alternatives{};  // other effects explaining nearly as much
   std::string feature_name{};
   std::vector<double> feature{};  // the explaining feature per sample
 };
