@@ -139,6 +139,8 @@ rug_case() {
   # Asserted: its polarization creeps during the holds, named on D from the field-drive model
   # without creep operators.
   local report="${name//\//-}-$structure"
+  # The disc set has no licence: its reports are made here and never kept.
+  local SELFSENSE_REPORT_DIR=
   case "$structure:$name" in
     charge-drive:*)
       diagnose "$report" "$work/rug.yaml" "$work/rug_fit.csv" "$work/rug_val.csv" || true
