@@ -213,9 +213,10 @@ Outcome run_case(const Case& c) {
   for (const diagnosis::Finding& f : o.result.findings) {
     std::printf("   %s on %s explains %.2f: %s\n", f.effect.c_str(), f.channel.c_str(), f.explains,
                 f.evidence.c_str());
-    for (const diagnosis::Alternative& a : f.alternatives)
+    for (const diagnosis::Alternative& a : f.alternatives) {
       std::printf("     alternative: %s (%.2f): %s\n", a.effect.c_str(), a.explains,
                   a.evidence.c_str());
+    }
   }
   return o;
 }
