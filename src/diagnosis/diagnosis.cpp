@@ -536,18 +536,28 @@ bool overlaps(const Segment& a, const Segment& b) {
   return a.begin < b.end && b.begin < a.end;
 }
 
-// Creep lives in the holds after steps; in a record of a few holds that differ (large steps
-// and small ones, switching and none) alternate time blocks judge it on stretches where it
-// barely shows. Then each hold is held out in turn (holds i, i + G, ... together, G <= 8
-// refits): the candidate is refitted on everything else and judged on how the residual moves
-// within the held-out hold (each hold's mean removed: creep is the movement, the level is the
-// static loop's). It passes when it explains at least `min_explains` of that movement over all
-// holds and in two holds or more (not one by chance), and makes no hold worse by more than
-// `max_block_loss` of the larger of that hold's and the mean hold's movement (a hold that
-// hardly moves is judged against the others, not against its own noise).
+// Held-out holds. Alternate time blocks cut each hold in two, so on a record of steps and holds a
+// term that draws each hold's level from the other half of the same hold passes them without
+// predicting anything new. Holding out whole holds (holds i, i + G, ... together, G <= 8 refits;
+// the candidate refitted on everything else) judges what it predicts for a hold it never saw.
+//  - Creep lives in the holds after steps; in a record of a few holds that differ (large steps
+//    and small ones, switching and none) the blocks judge it where it barely shows. It may pass on
+//    the holds instead: judged on how the residual moves within each held-out hold (the hold's
+//    mean removed: creep is the movement, the level is the static loop's), it must explain at
+//    least `min_explains` of that movement over all holds and in two holds or more (not one by
+//    chance).
+//  - A hysteresis operator (generic: it can draw any level) must also do no harm there: the
+//    residual over the held-out holds no larger than before.
+// Either way no hold may get worse by more than `max_block_loss` of the larger of its own and
+// the mean hold's residual (a hold that hardly moves is judged against the others, not against
+// its own noise).
+enum class HoldMeasure : std::uint8_t { kMovement, kLevel };
+
 struct HoldJudgement {
-  bool passes{false};
-  double explains{0.0};  // of the movement within the held-out holds
+  bool judged{false};
+  HoldMeasure measure{HoldMeasure::kMovement};
+  double explains{0.0};  // of the residual (or its movement) over the held-out holds
+  double worst{0.0};     // the largest relative loss in one hold
   std::size_t improved{0};
   std::size_t holds{0};
 };
@@ -556,7 +566,7 @@ HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
                              const std::vector<CorrectionTerm>& terms,
                              const ChannelCorrection& start, const Rows& rows,
                              const std::vector<double>& current, const std::vector<Segment>& holds,
-                             const Options& options) {
+                             HoldMeasure measure, const Options& options) {
   constexpr std::size_t kMaxRefits = 8;
   HoldJudgement j;
   j.holds = holds.size();
@@ -579,8 +589,8 @@ HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
         held_out[k] = fit.output[k];
     }
   }
-  // Movement within each hold: the residual's variance about its mean in the hold.
-  const auto movement = [&](const std::vector<double>& model, const Segment& h) {
+  // The residual's energy in a hold, about its mean in the hold when only movement counts.
+  const auto energy = [&](const std::vector<double>& model, const Segment& h) {
     double sum = 0.0;
     double sum2 = 0.0;
     double count = 0.0;
@@ -591,34 +601,45 @@ HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
       sum2 += e * e;
       count += 1.0;
     }
-    return count > 0.0 ? sum2 - sum * sum / count : 0.0;
+    if (count == 0.0) return 0.0;
+    return measure == HoldMeasure::kMovement ? sum2 - sum * sum / count : sum2;
   };
   std::vector<double> before(holds.size());
   std::vector<double> after(holds.size());
   double total_before = 0.0;
   double total_after = 0.0;
   for (std::size_t h = 0; h < holds.size(); ++h) {
-    before[h] = movement(current, holds[h]);
-    after[h] = movement(held_out, holds[h]);
+    before[h] = energy(current, holds[h]);
+    after[h] = energy(held_out, holds[h]);
     total_before += before[h];
     total_after += after[h];
   }
   if (!(total_before > 0.0)) return j;
   const double mean_before = total_before / static_cast<double>(holds.size());
-  double worst = 0.0;
   for (std::size_t h = 0; h < holds.size(); ++h) {
     if (before[h] > 0.0 && after[h] <= (1.0 - options.min_explains) * before[h]) ++j.improved;
-    worst = std::max(worst, (after[h] - before[h]) / std::max(before[h], mean_before));
+    j.worst = std::max(j.worst, (after[h] - before[h]) / std::max(before[h], mean_before));
   }
+  j.judged = true;
+  j.measure = measure;
   j.explains = 1.0 - total_after / total_before;
-  j.passes =
-      j.explains >= options.min_explains && j.improved >= 2 && worst <= options.max_block_loss;
   return j;
+}
+
+// Creep named on the holds (HoldMeasure::kMovement).
+bool creep_passes_on_holds(const HoldJudgement& j, const Options& options) {
+  return j.judged && j.measure == HoldMeasure::kMovement && j.explains >= options.min_explains &&
+         j.improved >= 2 && j.worst <= options.max_block_loss;
+}
+
+// A hysteresis operator's levels on the holds (HoldMeasure::kLevel).
+bool harmless_on_holds(const HoldJudgement& j, const Options& options) {
+  return !j.judged || (j.explains >= 0.0 && j.worst <= options.max_block_loss);
 }
 
 // How a finding was judged, for its evidence.
 std::string judged_on(const HoldJudgement& holds, const Options& options) {
-  if (!holds.passes) return "on held-out blocks";
+  if (!creep_passes_on_holds(holds, options)) return "on held-out blocks";
   return format(
              "on held-out blocks; judged on held-out holds, where it explains %.0f %% of the "
              "movement within them and more than %.0f %% in %.0f",
@@ -847,10 +868,17 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
           const double sse = sse_over(ch.recorded, fit.output, rows.judge);
           const double explains = 1.0 - sse / current_sse;
           const BlockShares shares = block_explains(ch.recorded, current, fit.output, rows);
+          const bool in_blocks =
+              shares.median >= options.min_explains && shares.worst >= -options.max_block_loss;
           HoldJudgement holds;
-          if (uses_term(c, CorrectionTerm::kCreep) && explains >= options.min_explains &&
-              !(shares.median >= options.min_explains && shares.worst >= -options.max_block_loss)) {
-            holds = judge_on_holds(cs, terms, start, rows, current, drive_holds, options);
+          if (explains >= options.min_explains) {
+            if (c.generic && in_blocks) {
+              holds = judge_on_holds(cs, terms, start, rows, current, drive_holds,
+                                     HoldMeasure::kLevel, options);
+            } else if (uses_term(c, CorrectionTerm::kCreep) && !in_blocks) {
+              holds = judge_on_holds(cs, terms, start, rows, current, drive_holds,
+                                     HoldMeasure::kMovement, options);
+            }
           }
           tried.push_back({&c, std::move(fit), explains, shares, holds});
         } catch (const std::invalid_argument&) {
@@ -863,7 +891,10 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       const auto significant = [&](const Tried& t) {
         const bool in_blocks =
             t.blocks.median >= options.min_explains && t.blocks.worst >= -options.max_block_loss;
-        return t.explains >= options.min_explains && (in_blocks || t.holds.passes) &&
+        const bool on_holds = t.candidate->generic
+                                  ? in_blocks && harmless_on_holds(t.holds, options)
+                                  : in_blocks || creep_passes_on_holds(t.holds, options);
+        return t.explains >= options.min_explains && on_holds &&
                t.explains * current_sse >= options.min_share * original_sse;
       };
       // Specific physics first: when one is significant, a generic candidate competes only if

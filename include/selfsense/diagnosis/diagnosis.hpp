@@ -12,10 +12,11 @@
 //      residual, overall and in the median held-out block (a term that fits one stretch by
 //      chance is not named); creep, which lives in the holds after steps, may instead pass on
 //      held-out holds (each hold refitted without it: the movement within the holds explained,
-//      in two or more); of candidates explaining about as much, the simplest wins; candidates
-//      that pass too and explain nearly as much are reported as alternatives, with their own
-//      evidence; then the search repeats on what is left (several effects in turn), refitting
-//      the accepted terms jointly with each new candidate
+//      in two or more), and a hysteresis operator, which can draw any level, must also leave the
+//      held-out holds no worse; of candidates explaining about as much, the simplest wins;
+//      candidates that pass too and explain nearly as much are reported as alternatives, with
+//      their own evidence; then the search repeats on what is left (several effects in turn),
+//      refitting the accepted terms jointly with each new candidate
 //   4. the accepted corrections go into the model, which the runtime runs per sample.
 // A model that already carries corrections is diagnosed from its sides alone (its corrections
 // are found again if still needed).
