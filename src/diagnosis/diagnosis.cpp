@@ -572,6 +572,7 @@ HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
   j.holds = holds.size();
   if (holds.size() < 3) return j;
   const std::size_t n = current.size();
+  j.measure = measure;
   const std::size_t groups = std::min(holds.size(), kMaxRefits);
   std::vector<double> held_out(current);
   for (std::size_t g = 0; g < groups; ++g) {
@@ -582,8 +583,15 @@ HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
       for (std::size_t k = holds[h].begin; k < holds[h].end; ++k)
         fit_rows[k] = false;
     }
-    const identification::CorrectionFit fit =
-        identification::fit_correction(cs, terms, start, fit_rows);
+    identification::CorrectionFit fit;
+    try {
+      fit = identification::fit_correction(cs, terms, start, fit_rows);
+    } catch (const std::invalid_argument&) {
+      // No finite fit without these holds: the candidate cannot predict them.
+      j.judged = true;
+      j.explains = -std::numeric_limits<double>::infinity();
+      return j;
+    }
     for (std::size_t h = g; h < holds.size(); h += groups) {
       for (std::size_t k = holds[h].begin; k < holds[h].end; ++k)
         held_out[k] = fit.output[k];
@@ -621,7 +629,6 @@ HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
     j.worst = std::max(j.worst, (after[h] - before[h]) / std::max(before[h], mean_before));
   }
   j.judged = true;
-  j.measure = measure;
   j.explains = 1.0 - total_after / total_before;
   return j;
 }
@@ -835,6 +842,9 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         double explains;
         BlockShares blocks;  // over the held-out blocks
         HoldJudgement holds;
+        std::vector<CorrectionTerm> terms;
+        ChannelCorrection start;
+        bool levels_judged;  // on held-out holds (hysteresis operators, when needed)
       };
       std::vector<Tried> tried;
       for (const Candidate& c : candidates()) {
@@ -868,19 +878,13 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
           const double sse = sse_over(ch.recorded, fit.output, rows.judge);
           const double explains = 1.0 - sse / current_sse;
           const BlockShares shares = block_explains(ch.recorded, current, fit.output, rows);
-          const bool in_blocks =
-              shares.median >= options.min_explains && shares.worst >= -options.max_block_loss;
           HoldJudgement holds;
-          if (explains >= options.min_explains) {
-            if (c.generic && in_blocks) {
-              holds = judge_on_holds(cs, terms, start, rows, current, drive_holds,
-                                     HoldMeasure::kLevel, options);
-            } else if (uses_term(c, CorrectionTerm::kCreep) && !in_blocks) {
-              holds = judge_on_holds(cs, terms, start, rows, current, drive_holds,
-                                     HoldMeasure::kMovement, options);
-            }
+          if (uses_term(c, CorrectionTerm::kCreep) && explains >= options.min_explains &&
+              !(shares.median >= options.min_explains && shares.worst >= -options.max_block_loss)) {
+            holds = judge_on_holds(cs, terms, start, rows, current, drive_holds,
+                                   HoldMeasure::kMovement, options);
           }
-          tried.push_back({&c, std::move(fit), explains, shares, holds});
+          tried.push_back({&c, std::move(fit), explains, shares, holds, terms, start, false});
         } catch (const std::invalid_argument&) {
           continue;  // no finite fit of this candidate on these signals: not a candidate here
         }
@@ -888,20 +892,29 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       if (tried.empty()) break;
       std::sort(tried.begin(), tried.end(),
                 [](const Tried& a, const Tried& b) { return a.explains > b.explains; });
-      const auto significant = [&](const Tried& t) {
+      // The held-out holds judge a hysteresis operator only when it would be named or listed
+      // (each judgement refits it up to 8 times).
+      const auto significant = [&](Tried& t) {
+        if (t.explains < options.min_explains ||
+            t.explains * current_sse < options.min_share * original_sse) {
+          return false;
+        }
         const bool in_blocks =
             t.blocks.median >= options.min_explains && t.blocks.worst >= -options.max_block_loss;
-        const bool on_holds = t.candidate->generic
-                                  ? in_blocks && harmless_on_holds(t.holds, options)
-                                  : in_blocks || creep_passes_on_holds(t.holds, options);
-        return t.explains >= options.min_explains && on_holds &&
-               t.explains * current_sse >= options.min_share * original_sse;
+        if (!t.candidate->generic) return in_blocks || creep_passes_on_holds(t.holds, options);
+        if (!in_blocks) return false;
+        if (!t.levels_judged) {
+          t.levels_judged = true;
+          t.holds = judge_on_holds(cs, t.terms, t.start, rows, current, drive_holds,
+                                   HoldMeasure::kLevel, options);
+        }
+        return harmless_on_holds(t.holds, options);
       };
       // Specific physics first: when one is significant, a generic candidate competes only if
       // it leaves clearly less (a loop the specific terms merely resemble); otherwise it is an
       // alternative and may explain what is left in a later round.
       double specific_left = std::numeric_limits<double>::infinity();
-      for (const Tried& t : tried) {
+      for (Tried& t : tried) {
         if (!t.candidate->generic && significant(t)) {
           specific_left = std::min(specific_left, 1.0 - t.explains);
         }
@@ -921,7 +934,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         }
       }
       std::swap(tried[0], tried[chosen]);
-      const Tried& best = tried.front();
+      Tried& best = tried.front();
       if (!significant(best)) break;
 
       Finding f;
