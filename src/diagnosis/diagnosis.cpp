@@ -538,8 +538,9 @@ bool overlaps(const Segment& a, const Segment& b) {
 
 // Held-out holds. Alternate time blocks cut each hold in two, so on a record of steps and holds a
 // term that draws each hold's level from the other half of the same hold passes them without
-// predicting anything new. Holding out whole holds (holds i, i + G, ... together, G <= 8 refits;
-// the candidate refitted on everything else) judges what it predicts for a hold it never saw.
+// predicting anything new. Holding out whole holds (holds i, i + G, ... together, G <= 8 folds;
+// the candidate refitted on everything else, identification::held_out_outputs) judges what it
+// predicts for a hold it never saw.
 //  - Creep lives in the holds after steps; in a record of a few holds that differ (large steps
 //    and small ones, switching and none) the blocks judge it where it barely shows. It may pass on
 //    the holds instead: judged on how the residual moves within each held-out hold (the hold's
@@ -567,35 +568,35 @@ HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
                              const ChannelCorrection& start, const Rows& rows,
                              const std::vector<double>& current, const std::vector<Segment>& holds,
                              HoldMeasure measure, const Options& options) {
-  constexpr std::size_t kMaxRefits = 8;
+  constexpr std::size_t kMaxFolds = 8;
   HoldJudgement j;
   j.holds = holds.size();
   if (holds.size() < 3) return j;
   const std::size_t n = current.size();
   j.measure = measure;
-  const std::size_t groups = std::min(holds.size(), kMaxRefits);
+  const std::size_t groups = std::min(holds.size(), kMaxFolds);
+  std::vector<int> fold(n, -1);
+  for (std::size_t h = 0; h < holds.size(); ++h) {
+    for (std::size_t k = holds[h].begin; k < holds[h].end; ++k)
+      fold[k] = static_cast<int>(h % groups);
+  }
+  std::vector<bool> usable(n);
+  for (std::size_t k = 0; k < n; ++k)
+    usable[k] = rows.fit[k] || rows.judge[k];
+  std::vector<std::vector<double>> outputs;
+  try {
+    outputs = identification::held_out_outputs(cs, terms, start, usable, fold, groups);
+  } catch (const std::invalid_argument&) {
+    // No finite fit without some holds: the candidate cannot predict them.
+    j.judged = true;
+    j.explains = -std::numeric_limits<double>::infinity();
+    return j;
+  }
   std::vector<double> held_out(current);
-  for (std::size_t g = 0; g < groups; ++g) {
-    std::vector<bool> fit_rows(n);
-    for (std::size_t k = 0; k < n; ++k)
-      fit_rows[k] = rows.fit[k] || rows.judge[k];
-    for (std::size_t h = g; h < holds.size(); h += groups) {
-      for (std::size_t k = holds[h].begin; k < holds[h].end; ++k)
-        fit_rows[k] = false;
-    }
-    identification::CorrectionFit fit;
-    try {
-      fit = identification::fit_correction(cs, terms, start, fit_rows);
-    } catch (const std::invalid_argument&) {
-      // No finite fit without these holds: the candidate cannot predict them.
-      j.judged = true;
-      j.explains = -std::numeric_limits<double>::infinity();
-      return j;
-    }
-    for (std::size_t h = g; h < holds.size(); h += groups) {
-      for (std::size_t k = holds[h].begin; k < holds[h].end; ++k)
-        held_out[k] = fit.output[k];
-    }
+  for (std::size_t h = 0; h < holds.size(); ++h) {
+    const std::vector<double>& out = outputs[h % groups];
+    for (std::size_t k = holds[h].begin; k < holds[h].end; ++k)
+      held_out[k] = out[k];
   }
   // The residual's energy in a hold, about its mean in the hold when only movement counts.
   const auto energy = [&](const std::vector<double>& model, const Segment& h) {
@@ -893,7 +894,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       std::sort(tried.begin(), tried.end(),
                 [](const Tried& a, const Tried& b) { return a.explains > b.explains; });
       // The held-out holds judge a hysteresis operator only when it would be named or listed
-      // (each judgement refits it up to 8 times).
+      // (each judgement costs a fit).
       const auto significant = [&](Tried& t) {
         if (t.explains < options.min_explains ||
             t.explains * current_sse < options.min_share * original_sse) {

@@ -358,28 +358,37 @@ struct Solved {
   double sse{std::numeric_limits<double>::infinity()};
 };
 
-Solved solve(std::span<const double> target, std::span<const std::span<const double>> columns,
-             const std::vector<bool>& rows) {
-  const auto p = static_cast<Eigen::Index>(columns.size());
-  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(p, p);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(p);
-  double energy = 0.0;
-  Eigen::VectorXd row(p);
-  for (std::size_t k = 0; k < target.size(); ++k) {
-    if (!rows[k]) continue;
-    for (Eigen::Index i = 0; i < p; ++i)
-      row[i] = columns[static_cast<std::size_t>(i)][k];
-    g.selfadjointView<Eigen::Lower>().rankUpdate(row);
-    b += row * target[k];
-    energy += target[k] * target[k];
-  }
+// The normal equations of least squares: G = A'A, b = A'y over some rows.
+struct Normal {
+  Eigen::MatrixXd g;
+  Eigen::VectorXd b;
+  double energy{0.0};  // y'y
+};
+
+Normal zero_normal(Eigen::Index p) {
+  return {Eigen::MatrixXd::Zero(p, p), Eigen::VectorXd::Zero(p), 0.0};
+}
+
+// Adds sample k to the normal equations (G in its lower triangle).
+void accumulate(Normal& n, std::span<const double> target,
+                std::span<const std::span<const double>> columns, std::size_t k,
+                Eigen::VectorXd& row) {
+  for (Eigen::Index i = 0; i < row.size(); ++i)
+    row[i] = columns[static_cast<std::size_t>(i)][k];
+  n.g.selfadjointView<Eigen::Lower>().rankUpdate(row);
+  n.b += row * target[k];
+  n.energy += target[k] * target[k];
+}
+
+Solved solve_normal(Normal n) {
+  const Eigen::Index p = n.b.size();
   Solved out;
   if (p == 0) {
-    out.sse = energy;
+    out.sse = n.energy;
     out.coefficients = Eigen::VectorXd();
     return out;
   }
-  g = g.selfadjointView<Eigen::Lower>();
+  const Eigen::MatrixXd g = n.g.selfadjointView<Eigen::Lower>();
   Eigen::VectorXd scale = g.diagonal().cwiseSqrt();
   for (Eigen::Index i = 0; i < p; ++i) {
     if (!(scale[i] > 0.0)) scale[i] = 1.0;
@@ -392,7 +401,7 @@ Solved solve(std::span<const double> target, std::span<const std::span<const dou
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(gs);
   const Eigen::VectorXd& lambda = eig.eigenvalues();
   const double floor = 1e-10 * std::max(lambda.maxCoeff(), 0.0);
-  const Eigen::VectorXd projected = eig.eigenvectors().transpose() * b.cwiseQuotient(scale);
+  const Eigen::VectorXd projected = eig.eigenvectors().transpose() * n.b.cwiseQuotient(scale);
   Eigen::VectorXd weighted = Eigen::VectorXd::Zero(p);
   for (Eigen::Index i = 0; i < p; ++i) {
     if (lambda[i] > floor) weighted[i] = projected[i] / lambda[i];
@@ -400,8 +409,86 @@ Solved solve(std::span<const double> target, std::span<const std::span<const dou
   const Eigen::VectorXd theta = eig.eigenvectors() * weighted;
   out.coefficients = theta.cwiseQuotient(scale);
   out.sse = std::max(
-      0.0, energy - 2.0 * out.coefficients.dot(b) + out.coefficients.dot(g * out.coefficients));
+      0.0, n.energy - 2.0 * out.coefficients.dot(n.b) + out.coefficients.dot(g * out.coefficients));
   return out;
+}
+
+Solved solve(std::span<const double> target, std::span<const std::span<const double>> columns,
+             const std::vector<bool>& rows) {
+  const auto p = static_cast<Eigen::Index>(columns.size());
+  Normal n = zero_normal(p);
+  Eigen::VectorXd row(p);
+  for (std::size_t k = 0; k < target.size(); ++k) {
+    if (rows[k]) accumulate(n, target, columns, k, row);
+  }
+  return solve_normal(std::move(n));
+}
+
+// The regressors of a fit with the given filters: the columns (filtered when there are filters)
+// and the target recorded - F[y].
+struct Regressors {
+  std::vector<std::vector<double>> owned{};
+  std::vector<std::span<const double>> columns{};
+  std::vector<double> target{};
+};
+
+Regressors regressors(const CorrectionSignals& s, const Columns& columns,
+                      const ChannelCorrection& filters) {
+  // Unfiltered columns are read in place (a 1e6-sample recording: no copies per evaluation).
+  const bool any_filter = !filters.empty();
+  const std::size_t n = s.y.size();
+  Regressors r;
+  r.columns.reserve(columns.phi.size());
+  if (any_filter) r.owned.reserve(columns.phi.size());
+  for (const std::vector<double>& phi : columns.phi) {
+    if (any_filter) {
+      r.owned.push_back(filtered(phi, filters, s.sample_time));
+      r.columns.emplace_back(r.owned.back());
+    } else {
+      r.columns.emplace_back(phi);
+    }
+  }
+  r.target.assign(s.recorded.begin(), s.recorded.end());
+  if (any_filter) {
+    const std::vector<double> fy = filtered(s.y, filters, s.sample_time);
+    for (std::size_t k = 0; k < n; ++k)
+      r.target[k] -= fy[k];
+  } else {
+    for (std::size_t k = 0; k < n; ++k)
+      r.target[k] -= s.y[k];
+  }
+  return r;
+}
+
+void check_signals(const CorrectionSignals& s, const std::vector<bool>& fit_rows) {
+  const std::size_t n = s.y.size();
+  if (n == 0 || s.recorded.size() != n || s.drive.size() != n || fit_rows.size() != n ||
+      (!s.stress.empty() && s.stress.size() != n) ||
+      (!s.temperature.empty() && s.temperature.size() != n) ||
+      (!s.sensed.empty() && s.sensed.size() != n) ||
+      (!s.response.empty() && s.response.size() != n) || !(s.sample_time > 0.0)) {
+    throw std::invalid_argument("fit_correction: signals of mismatched size or no sample time");
+  }
+  if (std::none_of(fit_rows.begin(), fit_rows.end(), [](bool b) { return b; })) {
+    throw std::invalid_argument("fit_correction: no fitting rows");
+  }
+}
+
+// The correction of solved coefficients (throws when the model's output would enter inverted).
+ChannelCorrection correction_of(const CorrectionSignals& s, std::span<const CorrectionTerm> terms,
+                                const Columns& columns, const Solved& solved,
+                                const ChannelCorrection& filters) {
+  if (solved.coefficients.size() != static_cast<Eigen::Index>(columns.phi.size())) {
+    throw std::invalid_argument("fit_correction: no finite fit (non-finite signals?)");
+  }
+  ChannelCorrection c = filters;
+  c.temperature_reference_degc = s.temperature_reference_degc;
+  apply_coefficients(terms, columns, solved.coefficients, c);
+  if (!(1.0 + c.gain > 0.0)) {
+    // The model's output would enter inverted (or not at all): not a correction of it.
+    throw std::invalid_argument("fit_correction: the fit needs 1 + gain <= 0");
+  }
+  return c;
 }
 
 }  // namespace
@@ -421,45 +508,14 @@ std::vector<double> apply_correction(const CorrectionSignals& s,
 CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const CorrectionTerm> terms,
                              const models::ChannelCorrection& start,
                              const std::vector<bool>& fit_rows) {
+  check_signals(s, fit_rows);
   const std::size_t n = s.y.size();
-  if (n == 0 || s.recorded.size() != n || s.drive.size() != n || fit_rows.size() != n ||
-      (!s.stress.empty() && s.stress.size() != n) ||
-      (!s.temperature.empty() && s.temperature.size() != n) ||
-      (!s.sensed.empty() && s.sensed.size() != n) ||
-      (!s.response.empty() && s.response.size() != n) || !(s.sample_time > 0.0)) {
-    throw std::invalid_argument("fit_correction: signals of mismatched size or no sample time");
-  }
-  if (std::none_of(fit_rows.begin(), fit_rows.end(), [](bool b) { return b; })) {
-    throw std::invalid_argument("fit_correction: no fitting rows");
-  }
   const Columns columns = make_columns(s, terms);
   Solved best;
   ChannelCorrection best_filters;
   const auto evaluate = [&](const ChannelCorrection& filters) {
-    // Unfiltered columns are read in place (a 1e6-sample recording: no copies per evaluation).
-    const bool any_filter = !filters.empty();
-    std::vector<std::vector<double>> owned;
-    std::vector<std::span<const double>> cols;
-    cols.reserve(columns.phi.size());
-    if (any_filter) owned.reserve(columns.phi.size());
-    for (const std::vector<double>& phi : columns.phi) {
-      if (any_filter) {
-        owned.push_back(filtered(phi, filters, s.sample_time));
-        cols.emplace_back(owned.back());
-      } else {
-        cols.emplace_back(phi);
-      }
-    }
-    std::vector<double> target(s.recorded.begin(), s.recorded.end());
-    if (any_filter) {
-      const std::vector<double> fy = filtered(s.y, filters, s.sample_time);
-      for (std::size_t k = 0; k < n; ++k)
-        target[k] -= fy[k];
-    } else {
-      for (std::size_t k = 0; k < n; ++k)
-        target[k] -= s.y[k];
-    }
-    Solved solved = solve(target, cols, fit_rows);
+    const Regressors r = regressors(s, columns, filters);
+    Solved solved = solve(r.target, r.columns, fit_rows);
     if (solved.sse < best.sse) {
       best = std::move(solved);
       best_filters = filters;
@@ -475,17 +531,8 @@ CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const Correct
     }
   }
   refine(s, terms, start, best_filters, evaluate);
-  if (best.coefficients.size() != static_cast<Eigen::Index>(columns.phi.size())) {
-    throw std::invalid_argument("fit_correction: no finite fit (non-finite signals?)");
-  }
   CorrectionFit fit;
-  fit.correction = best_filters;
-  fit.correction.temperature_reference_degc = s.temperature_reference_degc;
-  apply_coefficients(terms, columns, best.coefficients, fit.correction);
-  if (!(1.0 + fit.correction.gain > 0.0)) {
-    // The model's output would enter inverted (or not at all): not a correction of it.
-    throw std::invalid_argument("fit_correction: the fit needs 1 + gain <= 0");
-  }
+  fit.correction = correction_of(s, terms, columns, best, best_filters);
   fit.output = apply_correction(s, fit.correction);
   for (std::size_t k = 0; k < n; ++k) {
     if (!fit_rows[k]) continue;
@@ -493,6 +540,59 @@ CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const Correct
     fit.fit_sse += e * e;
   }
   return fit;
+}
+
+std::vector<std::vector<double>> held_out_outputs(const CorrectionSignals& s,
+                                                  std::span<const CorrectionTerm> terms,
+                                                  const models::ChannelCorrection& start,
+                                                  const std::vector<bool>& fit_rows,
+                                                  std::span<const int> fold, std::size_t folds) {
+  check_signals(s, fit_rows);
+  const std::size_t n = s.y.size();
+  if (fold.size() != n) throw std::invalid_argument("held_out_outputs: a fold per sample");
+  const std::vector<ChannelCorrection> grid = filter_grid(s, terms, start);
+  if (grid.size() != 1) {
+    throw std::invalid_argument("held_out_outputs: the filters must be chosen (in start)");
+  }
+  const Columns columns = make_columns(s, terms);
+  const Regressors r = regressors(s, columns, grid.front());
+  const auto p = static_cast<Eigen::Index>(r.columns.size());
+  // One pass over the samples: the normal equations of every fitting row, and of each fold's.
+  Normal all = zero_normal(p);
+  std::vector<Normal> of_fold(folds, zero_normal(p));
+  Eigen::VectorXd row(p);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!fit_rows[k]) continue;
+    const int f = fold[k];
+    if (f >= 0 && static_cast<std::size_t>(f) < folds) {
+      accumulate(of_fold[static_cast<std::size_t>(f)], r.target, r.columns, k, row);
+    } else {
+      accumulate(all, r.target, r.columns, k, row);
+    }
+  }
+  std::vector<std::vector<double>> out;
+  out.reserve(folds);
+  for (std::size_t f = 0; f < folds; ++f) {
+    Normal without = all;
+    for (std::size_t g = 0; g < folds; ++g) {
+      if (g == f) continue;
+      without.g += of_fold[g].g;
+      without.b += of_fold[g].b;
+      without.energy += of_fold[g].energy;
+    }
+    const Solved solved = solve_normal(std::move(without));
+    static_cast<void>(correction_of(s, terms, columns, solved, grid.front()));  // checks the fit
+    // out = F[y] + sum_i c_i F[phi_i], with F[y] = recorded - target.
+    std::vector<double> output(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      double sum = s.recorded[k] - r.target[k];
+      for (Eigen::Index i = 0; i < p; ++i)
+        sum += solved.coefficients[i] * r.columns[static_cast<std::size_t>(i)][k];
+      output[k] = sum;
+    }
+    out.push_back(std::move(output));
+  }
+  return out;
 }
 
 }  // namespace selfsense::identification

@@ -61,6 +61,16 @@ struct CorrectionFit {
                                            const models::ChannelCorrection& start,
                                            const std::vector<bool>& fit_rows);
 
+// Refits with folds held out (cross-validation): for each fold f, the fit on the fitting rows
+// outside fold f (fold[k] = f; -1: no fold), its corrected output over the whole recording. The
+// filters are those of `start` (none searched; throws std::invalid_argument otherwise). The
+// regressors are computed once and each fold's share of the normal equations once, so F folds
+// cost one fit and F small solves. Throws as fit_correction does.
+[[nodiscard]] std::vector<std::vector<double>> held_out_outputs(
+    const CorrectionSignals& signals, std::span<const CorrectionTerm> terms,
+    const models::ChannelCorrection& start, const std::vector<bool>& fit_rows,
+    std::span<const int> fold, std::size_t folds);
+
 // Runs a correction over a whole recording (the runtime's CorrectionStage, so the figures are
 // those the loop will see).
 [[nodiscard]] std::vector<double> apply_correction(const CorrectionSignals& signals,

@@ -1,0 +1,102 @@
+// The least squares of a channel correction: planted coefficients found, and the held-out refits
+// (cross-validation by folds) equal to fits without each fold.
+#include "selfsense/identification/correction_fit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace selfsense::identification {
+namespace {
+
+constexpr double kTs = 1e-3;
+
+struct Bench {
+  std::vector<double> x, y, recorded;
+  CorrectionSignals signals() const {
+    CorrectionSignals s;
+    s.y = y;
+    s.recorded = recorded;
+    s.drive = x;
+    s.sample_time = kTs;
+    return s;
+  }
+};
+
+// A drive of holds and sines; the model's output 2 x; the recording 1.05 times it, 0.02 higher
+// and with a small loop (a play of the drive), so the hysteresis terms have something to fit.
+Bench bench() {
+  Bench b;
+  double play = 0.0;
+  for (int k = 0; k < 6000; ++k) {
+    const double t = k * kTs;
+    const int level = k / 500;  // a hold every 0.5 s, then a sine
+    const double x = (k < 3000) ? 0.2 * level : std::sin(8.17 * t);
+    play = std::clamp(play, x - 0.1, x + 0.1);
+    b.x.push_back(x);
+    b.y.push_back(2.0 * x);
+    b.recorded.push_back(1.05 * 2.0 * x + 0.02 + 0.05 * play);
+  }
+  return b;
+}
+
+TEST(CorrectionFit, FindsAPlantedGainAndOffset) {
+  Bench b = bench();
+  for (std::size_t k = 0; k < b.x.size(); ++k)
+    b.recorded[k] = 1.05 * b.y[k] + 0.02;
+  const std::vector<CorrectionTerm> terms{CorrectionTerm::kOffset};
+  const CorrectionFit fit =
+      fit_correction(b.signals(), terms, {}, std::vector<bool>(b.x.size(), true));
+  EXPECT_NEAR(fit.correction.gain, 0.05, 1e-12);
+  EXPECT_NEAR(fit.correction.offset, 0.02, 1e-12);
+  EXPECT_LT(fit.fit_sse, 1e-20);
+}
+
+TEST(CorrectionFit, HeldOutOutputsEqualFitsWithoutEachFold) {
+  const Bench b = bench();
+  const std::size_t n = b.x.size();
+  const std::vector<CorrectionTerm> terms{CorrectionTerm::kHysteresis, CorrectionTerm::kOffset};
+  std::vector<bool> rows(n, true);
+  rows[17] = false;  // a sample no fit may use
+  std::vector<int> fold(n, -1);
+  for (std::size_t k = 0; k < 3000; ++k)
+    fold[k] = static_cast<int>((k / 500) % 3);  // six holds in three folds
+  const std::vector<std::vector<double>> out =
+      held_out_outputs(b.signals(), terms, {}, rows, fold, 3);
+  ASSERT_EQ(out.size(), 3U);
+  for (int f = 0; f < 3; ++f) {
+    std::vector<bool> without = rows;
+    for (std::size_t k = 0; k < n; ++k)
+      without[k] = without[k] && fold[k] != f;
+    const CorrectionFit fit = fit_correction(b.signals(), terms, {}, without);
+    ASSERT_EQ(out[static_cast<std::size_t>(f)].size(), n);
+    double largest = 0.0;
+    for (std::size_t k = 0; k < n; ++k)
+      largest = std::max(largest, std::abs(out[static_cast<std::size_t>(f)][k] - fit.output[k]));
+    EXPECT_LT(largest, 1e-9) << "fold " << f;
+  }
+}
+
+TEST(CorrectionFit, HeldOutOutputsNeedTheFiltersChosen) {
+  const Bench b = bench();
+  const std::vector<CorrectionTerm> terms{CorrectionTerm::kLeakage, CorrectionTerm::kOffset};
+  const std::vector<int> fold(b.x.size(), 0);
+  EXPECT_THROW(static_cast<void>(held_out_outputs(b.signals(), terms, {},
+                                                  std::vector<bool>(b.x.size(), true), fold, 1)),
+               std::invalid_argument);
+  models::ChannelCorrection chosen;
+  chosen.leakage_tau_s = 50.0;
+  std::vector<int> two(b.x.size(), -1);
+  for (std::size_t k = 0; k < 1000; ++k)
+    two[k] = 0;
+  EXPECT_EQ(
+      held_out_outputs(b.signals(), terms, chosen, std::vector<bool>(b.x.size(), true), two, 1)
+          .size(),
+      1U);
+}
+
+}  // namespace
+}  // namespace selfsense::identification
