@@ -190,6 +190,11 @@ BlockShares block_explains(std::span<const double> recorded, const std::vector<d
   return {share[share.size() / 2], share.front()};
 }
 
+// The block test: the median held-out block gains `min_explains`, none loses `max_block_loss`.
+bool passes_blocks(const BlockShares& shares, const Options& options) {
+  return shares.median >= options.min_explains && shares.worst >= -options.max_block_loss;
+}
+
 double sse_over(std::span<const double> recorded, const std::vector<double>& model,
                 const std::vector<bool>& rows) {
   double sse = 0.0;
@@ -201,8 +206,6 @@ double sse_over(std::span<const double> recorded, const std::vector<double>& mod
   return sse;
 }
 
-// Non-finite model outputs (a rejected first sample) are held at the last finite value so no
-// filter state sees them; `usable` marks the samples that were finite.
 // A channel's response to the drive alone, r = y - coupling T (y itself without a stress).
 std::vector<double> response_to_drive(std::span<const double> y, double coupling,
                                       std::span<const double> stress) {
@@ -212,6 +215,8 @@ std::vector<double> response_to_drive(std::span<const double> y, double coupling
   return r;
 }
 
+// Non-finite model outputs (a rejected first sample) are held at the last finite value so no
+// filter state sees them; `usable` marks the samples that were finite.
 std::vector<bool> hold_finite(std::vector<double>& y) {
   std::vector<bool> usable(y.size());
   double last = 0.0;
@@ -881,7 +886,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
           const BlockShares shares = block_explains(ch.recorded, current, fit.output, rows);
           HoldJudgement holds;
           if (uses_term(c, CorrectionTerm::kCreep) && explains >= options.min_explains &&
-              !(shares.median >= options.min_explains && shares.worst >= -options.max_block_loss)) {
+              !passes_blocks(shares, options)) {
             holds = judge_on_holds(cs, terms, start, rows, current, drive_holds,
                                    HoldMeasure::kMovement, options);
           }
@@ -900,8 +905,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
             t.explains * current_sse < options.min_share * original_sse) {
           return false;
         }
-        const bool in_blocks =
-            t.blocks.median >= options.min_explains && t.blocks.worst >= -options.max_block_loss;
+        const bool in_blocks = passes_blocks(t.blocks, options);
         if (!t.candidate->generic) return in_blocks || creep_passes_on_holds(t.holds, options);
         if (!in_blocks) return false;
         if (!t.levels_judged) {

@@ -425,8 +425,16 @@ Solved solve(std::span<const double> target, std::span<const std::span<const dou
 }
 
 // The regressors of a fit with the given filters: the columns (filtered when there are filters)
-// and the target recorded - F[y].
+// and the target recorded - F[y]. `columns` views `owned` (or the unfiltered columns): a move
+// keeps those views valid, a copy would not, so there is none.
 struct Regressors {
+  Regressors() = default;
+  Regressors(const Regressors&) = delete;
+  Regressors& operator=(const Regressors&) = delete;
+  Regressors(Regressors&&) = default;
+  Regressors& operator=(Regressors&&) = default;
+  ~Regressors() = default;
+
   std::vector<std::vector<double>> owned{};
   std::vector<std::span<const double>> columns{};
   std::vector<double> target{};
