@@ -38,7 +38,11 @@ ConfigResult load_with(const std::vector<std::pair<std::string, std::string>>& e
     EXPECT_NE(at, std::string::npos) << from;
     if (at != std::string::npos) text.replace(at, from.size(), to);
   }
-  const std::filesystem::path path = kConfigDir / ".test-can.yaml";
+  // One file per test: CTest runs the tests of this program in parallel.
+  std::string file = ".";
+  file += ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  file += ".test-can.yaml";
+  const std::filesystem::path path = kConfigDir / file;
   std::ofstream(path) << text;
   ConfigResult r = load_config(path, &registry);
   std::filesystem::remove(path);
