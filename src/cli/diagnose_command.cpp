@@ -91,7 +91,7 @@ void run(const DiagnoseOptions& opt) {
       diagnosis::diagnose(model, to_signals(rec, model.drive()), options);
 
   nlohmann::json j;
-  j["verdict"] = result.mismatch ? "mismatch" : "consistent";
+  j["verdict"] = diagnosis::to_string(result.verdict);
   j["findings"] = nlohmann::json::array();
   for (const diagnosis::Finding& f : result.findings) {
     nlohmann::json where = nlohmann::json::array();
@@ -109,6 +109,18 @@ void run(const DiagnoseOptions& opt) {
                              {"explains", f.explains},
                              {"evidence", f.evidence},
                              {"alternatives", alternatives}});
+  }
+  j["unexplained"] = nlohmann::json::array();
+  for (const diagnosis::Unexplained& u : result.unexplained) {
+    nlohmann::json where = nlohmann::json::array();
+    for (const ReportSegment& s : seconds(u.where, rec.t)) {
+      where.push_back({{"t_start", s.t_start}, {"t_end", s.t_end}});
+    }
+    j["unexplained"].push_back({{"channel", u.channel},
+                                {"where", where},
+                                {"share", u.share},
+                                {"residual_rms", u.residual_rms},
+                                {"noise_floor", u.noise_floor}});
   }
   const std::vector<ChannelFigures> before = figures_of(model, rec);
   const std::vector<ChannelFigures> after = figures_of(result.improved, rec);
@@ -137,6 +149,8 @@ void run(const DiagnoseOptions& opt) {
     };
     channels.push_back(
         {{"channel", c.channel},
+         {"noise_floor", c.noise_floor},
+         {"residual_rms", c.residual_rms},
          {"located", located},
          {"residual_test", {{"before", test(c.test_before)}, {"after", test(c.test_after)}}}});
   }
@@ -154,6 +168,18 @@ void run(const DiagnoseOptions& opt) {
   report.recording_path = opt.recording.string();
   report.validate_path = opt.validate.string();
   report.verdict = j["verdict"];
+  for (const diagnosis::Unexplained& u : result.unexplained) {
+    const std::vector<ReportSegment> where = seconds(u.where, rec.t);
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "%s: residual RMS %.3g, %.1fx its noise floor %.3g; %.0f %% of it in %zu "
+                  "stretch(es) between %.3g s and %.3g s; no candidate reduces it on held-out data",
+                  u.channel.c_str(), u.residual_rms,
+                  u.noise_floor > 0.0 ? u.residual_rms / u.noise_floor : 0.0, u.noise_floor,
+                  100.0 * u.share, where.size(), where.empty() ? 0.0 : where.front().t_start,
+                  where.empty() ? 0.0 : where.back().t_end);
+    report.unexplained.emplace_back(line);
+  }
   report.t = rec.t;
   const std::span<const double> drive = rec.drive(model.drive());
   report.drive.assign(drive.begin(), drive.end());
@@ -196,11 +222,13 @@ void run(const DiagnoseOptions& opt) {
   report.fit_after = report_figures(after);
   write_diagnosis_report(report, opt.report);
 
-  std::printf("verdict: %s\n", result.mismatch ? "mismatch" : "consistent");
+  std::printf("verdict: %s\n", diagnosis::to_string(result.verdict));
   for (const diagnosis::Finding& f : result.findings) {
     std::printf("  %s on %s (explains %.0f %%): %s\n", f.effect.c_str(), f.channel.c_str(),
                 100.0 * f.explains, f.evidence.c_str());
   }
+  for (const std::string& u : report.unexplained)
+    std::printf("  unexplained on %s\n", u.c_str());
   const auto print = [](const char* what, const std::vector<ChannelFigures>& b,
                         const std::vector<ChannelFigures>& a) {
     for (std::size_t i = 0; i < b.size() && i < a.size(); ++i) {

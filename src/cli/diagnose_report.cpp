@@ -35,6 +35,7 @@ code { background: #f3f3f3; padding: 0 3px; word-break: break-all; }
 .verdict { padding: 1px 8px; border-radius: 4px; color: #fff; }
 .v-mismatch { background: #b03a2e; }
 .v-consistent { background: #2e7d32; }
+.v-unexplained { background: #b9770e; }
 .v-other { background: #666; }
 .plots { display: flex; flex-wrap: wrap; gap: 8px 16px; }
 figure { margin: 0; }
@@ -136,6 +137,7 @@ std::string header_section(const ReportInput& in) {
   std::string verdict_class = "v-other";
   if (in.verdict == "mismatch") verdict_class = "v-mismatch";
   if (in.verdict == "consistent") verdict_class = "v-consistent";
+  if (in.verdict == "unexplained") verdict_class = "v-unexplained";
   const std::string verdict = in.verdict.empty() ? "no verdict" : in.verdict;
   std::string out = "<h1>selfsense diagnose: <span class=\"verdict " + verdict_class + "\">" +
                     escape_html(verdict) + "</span></h1>\n<table class=\"paths\">\n";
@@ -189,7 +191,10 @@ std::string fit_section(const ReportInput& in) {
 
 std::string findings_section(const ReportInput& in) {
   std::string out = "<section id=\"findings\">\n<h2>Findings</h2>\n";
+  for (const std::string& u : in.unexplained)
+    out += "<p class=\"unexplained\">unexplained: " + escape_html(u) + "</p>\n";
   if (in.findings.empty()) {
+    if (!in.unexplained.empty()) return out + "</section>\n";
     return out + "<p>consistent: nothing left that the data can support naming</p>\n</section>\n";
   }
   out +=

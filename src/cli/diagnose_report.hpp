@@ -66,7 +66,9 @@ struct ReportInput {
   std::string model_path{};
   std::string recording_path{};
   std::string validate_path{};  // empty without --validate
-  std::string verdict{};        // "mismatch" or "consistent"
+  std::string verdict{};        // "mismatch", "unexplained" or "consistent"
+  // One sentence per residual well above the noise floor that no candidate reduces.
+  std::vector<std::string> unexplained{};
   std::vector<double> t{};      // [s]
   std::vector<double> drive{};  // the drive input (E [V/m], or D for charge drive)
   std::string drive_name{"E"};

@@ -6,7 +6,9 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <string_view>
 
+#include "selfsense/diagnosis/statistics.hpp"
 #include "selfsense/identification/correction_fit.hpp"
 #include "selfsense/models/runtime_model.hpp"
 
@@ -43,6 +45,19 @@ const std::vector<Candidate>& candidates() {
       // On the sensed channel the lags follow its response to the drive alone (D - d T), which
       // the reconstruction knows before the measurement (affine models).
       {"creep", {CorrectionTerm::kCreep, CorrectionTerm::kOffset}, true, true, Needs::kNothing},
+      // Creep driven by the input itself (the field's history, not the hysteresis output's).
+      {"creep",
+       {CorrectionTerm::kDriveCreep, CorrectionTerm::kOffset},
+       true,
+       true,
+       Needs::kNothing},
+      // Charge lost through the stack's parallel conductance: in proportion to the integral of
+      // the field (the high-pass above is the charge amplifier's feedback resistance).
+      {"charge_leakage",
+       {CorrectionTerm::kDriveIntegral, CorrectionTerm::kOffset},
+       true,
+       false,
+       Needs::kNothing},
       {"hysteresis",
        {CorrectionTerm::kHysteresis, CorrectionTerm::kOffset},
        true,
@@ -57,6 +72,13 @@ const std::vector<Candidate>& candidates() {
        true},
       {"temperature_dependence",
        {CorrectionTerm::kTemperature, CorrectionTerm::kOffset},
+       true,
+       true,
+       Needs::kTemperature},
+      // ... and quadratic in the temperature change (permittivity and coupling curve with it).
+      {"temperature_dependence",
+       {CorrectionTerm::kTemperature, CorrectionTerm::kTemperatureQuadratic,
+        CorrectionTerm::kOffset},
        true,
        true,
        Needs::kTemperature},
@@ -164,12 +186,12 @@ Rows make_rows(const std::vector<bool>& usable, std::size_t blocks) {
   return r;
 }
 
-// Share of the residual variance removed in each held-out block: the median is the figure a
-// candidate must reach (one block it fits by chance does not carry it), the worst says whether
+// Per held-out block, the residual's energy before and after a candidate: the paired t-test
+// over the blocks (statistics.hpp) says whether its gain is significant, the worst block whether
 // it makes some stretch worse (a term that does will not carry over to new data either).
 struct BlockShares {
-  double median{0.0};
-  double worst{0.0};
+  GainTest test{};
+  double worst{0.0};  // the largest relative loss of one block, as a (negative) share
 };
 
 BlockShares block_explains(std::span<const double> recorded, const std::vector<double>& before,
@@ -181,18 +203,28 @@ BlockShares block_explains(std::span<const double> recorded, const std::vector<d
     e0[rows.block[k]] += (recorded[k] - before[k]) * (recorded[k] - before[k]);
     e1[rows.block[k]] += (recorded[k] - after[k]) * (recorded[k] - after[k]);
   }
-  std::vector<double> share;
+  std::vector<double> held0;
+  std::vector<double> held1;
+  BlockShares out;
   for (std::size_t b = 1; b < rows.blocks; b += 2) {
-    if (e0[b] > 0.0) share.push_back(1.0 - e1[b] / e0[b]);
+    if (!(e0[b] > 0.0)) continue;
+    held0.push_back(e0[b]);
+    held1.push_back(e1[b]);
   }
-  if (share.empty()) return {};
-  std::sort(share.begin(), share.end());
-  return {share[share.size() / 2], share.front()};
+  // A block's loss relative to the larger of its own and the mean block's residual: a block
+  // where the model is already nearly right is judged against the others, not its own noise.
+  double mean = 0.0;
+  for (const double e : held0)
+    mean += e / static_cast<double>(held0.size());
+  for (std::size_t i = 0; i < held0.size(); ++i)
+    out.worst = std::min(out.worst, (held0[i] - held1[i]) / std::max(held0[i], mean));
+  out.test = paired_gain_test(held0, held1);
+  return out;
 }
 
-// The block test: the median held-out block gains `min_explains`, none loses `max_block_loss`.
+// The block test: a significant gain over the held-out blocks, none worse by `max_block_loss`.
 bool passes_blocks(const BlockShares& shares, const Options& options) {
-  return shares.median >= options.min_explains && shares.worst >= -options.max_block_loss;
+  return shares.test.significant && shares.worst >= -options.max_block_loss;
 }
 
 double sse_over(std::span<const double> recorded, const std::vector<double>& model,
@@ -282,12 +314,21 @@ void describe(Finding& f, const ChannelCorrection& c, const ChannelData& ch, con
     f.feature_name = "model output";
     f.feature = before;
   } else if (f.effect == "charge_leakage") {
-    f.evidence = "the measured " + n +
-                 format(
-                     " forgets its charge with a time constant of %.3g s (charge amplifier "
-                     "feedback or insulation resistance)",
-                     c.leakage_tau_s) +
-                 tail;
+    if (c.leakage_tau_s > 0.0) {
+      f.evidence = "the measured " + n +
+                   format(
+                       " forgets its charge with a time constant of %.3g s (charge amplifier "
+                       "feedback or insulation resistance)",
+                       c.leakage_tau_s) +
+                   tail;
+    } else {
+      f.evidence = "the measured " + n +
+                   format(
+                       " loses charge in proportion to the integral of the field (a parallel "
+                       "conductance of the stack: %.3g S/m)",
+                       -c.drive_integral_per_s) +
+                   tail;
+    }
     f.feature_name = "time [s]";
     f.feature.resize(before.size());
     for (std::size_t k = 0; k < before.size(); ++k) {
@@ -310,19 +351,26 @@ void describe(Finding& f, const ChannelCorrection& c, const ChannelData& ch, con
     f.feature_name = "rate of the drive [1/s]";
     f.feature = rate_of(s.drive, s.sample_time);
   } else if (f.effect == "creep") {
+    // Lags of the response (per unit of it) or of the drive (per unit of the drive: scaled by
+    // the channel's mean slope to the drive to read as a share of the step).
+    const bool of_drive = c.creep_eigenvalues.empty();
+    const std::vector<double>& lambda = of_drive ? c.drive_creep_eigenvalues : c.creep_eigenvalues;
     double total = 0.0;
-    for (const double w : c.creep_weights)
+    for (const double w : of_drive ? c.drive_creep_weights : c.creep_weights)
       total += w;
+    if (of_drive) {
+      const double drive_range = range_of(s.drive);
+      total *= drive_range > 0.0 && range > 0.0 ? drive_range / range : 0.0;
+    }
     const double decades =
-        c.creep_eigenvalues.empty()
-            ? 1.0
-            : std::max(1.0, std::log10(c.creep_eigenvalues.back() / c.creep_eigenvalues.front()));
+        lambda.empty() ? 1.0 : std::max(1.0, std::log10(lambda.back() / lambda.front()));
     const std::string span =
         decades > 1.0 ? format("%.2g decades of lags", decades) : std::string("lags over a decade");
     f.evidence = "after steps of the drive the recorded " + n +
                  format(" keeps moving by %.2g %% of the step per decade of time (",
                         100.0 * total / decades) +
-                 span + ")" + tail;
+                 span + (of_drive ? ", driven by the input" : ", driven by the model's output") +
+                 ")" + tail;
     f.feature_name = "log10 time since the drive last stepped [s]";
     f.feature = log_time_since_step(s.drive, s.sample_time);
   } else if (f.effect == "hysteresis" || f.effect == "asymmetric_hysteresis") {
@@ -360,6 +408,10 @@ void describe(Finding& f, const ChannelCorrection& c, const ChannelData& ch, con
                      "over %.3g K",
                      100.0 * c.temperature_gain_per_k, c.temperature_offset_per_k * pct,
                      range_of(s.temperature)) +
+                 (c.temperature_gain_per_k2 != 0.0 || c.temperature_offset_per_k2 != 0.0
+                      ? format(" (and %.3g %%/K^2, %.3g %% of range/K^2: quadratic in the change)",
+                               100.0 * c.temperature_gain_per_k2, c.temperature_offset_per_k2 * pct)
+                      : std::string()) +
                  tail;
     f.feature_name = "temperature [degC]";
     f.feature.assign(s.temperature.begin(), s.temperature.end());
@@ -432,7 +484,9 @@ bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, boo
   const auto uses = [&](CorrectionTerm t) { return uses_term(c, t); };
   // T^2 on the sensed channel is solved with the sensor coupling; leakage is a charge's.
   if (uses(CorrectionTerm::kStressQuadratic) && ch.coupling == 0.0) return false;
-  if (uses(CorrectionTerm::kLeakage) && charge_drive) return false;
+  if ((uses(CorrectionTerm::kLeakage) || uses(CorrectionTerm::kDriveIntegral)) && charge_drive) {
+    return false;
+  }
   if (uses(CorrectionTerm::kCreep) && ch.sensed && !ch.affine) return false;
   switch (c.needs) {
     case Needs::kTemperature:
@@ -454,15 +508,16 @@ bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, boo
 // must move with the step: never fall back past where it started, and give back at most half of
 // what it gained (a ferroelectric relaxes partly after switching; a lag bank imitating charge
 // leakage, or the phase of a periodic drive, gives it all back or turns against the step).
-bool creep_moves_with_the_step(const ChannelCorrection& c) {
+bool lags_move_with_the_step(const std::vector<double>& eigenvalues,
+                             const std::vector<double>& weights) {
   const auto s = [&](double t) {
     double sum = 0.0;
-    for (std::size_t j = 0; j < c.creep_weights.size(); ++j)
-      sum += c.creep_weights[j] * -std::expm1(-c.creep_eigenvalues[j] * t);
+    for (std::size_t j = 0; j < weights.size(); ++j)
+      sum += weights[j] * -std::expm1(-eigenvalues[j] * t);
     return sum;
   };
-  if (c.creep_eigenvalues.empty()) return false;
-  const auto [lo, hi] = std::minmax_element(c.creep_eigenvalues.begin(), c.creep_eigenvalues.end());
+  if (eigenvalues.empty()) return false;
+  const auto [lo, hi] = std::minmax_element(eigenvalues.begin(), eigenvalues.end());
   // 20 points per decade from a tenth of the fastest time constant to 100 slowest ones.
   const double t0 = 0.1 / *hi;
   const auto points = static_cast<int>(std::ceil(20.0 * std::log10(1000.0 * *hi / *lo)));
@@ -475,6 +530,27 @@ bool creep_moves_with_the_step(const ChannelCorrection& c) {
   }
   const double final_value = s(std::numeric_limits<double>::infinity());
   return peak > 0.0 && lowest >= -0.05 * peak && final_value >= 0.5 * peak;
+}
+
+// Both forms of creep (lags of the response, lags of the drive): each bank present moves with
+// the step (the drive raises D and S, so the drive's lags must push the same way).
+bool creep_moves_with_the_step(const ChannelCorrection& c) {
+  if (c.creep_eigenvalues.empty() && c.drive_creep_eigenvalues.empty()) return false;
+  return (c.creep_eigenvalues.empty() ||
+          lags_move_with_the_step(c.creep_eigenvalues, c.creep_weights)) &&
+         (c.drive_creep_eigenvalues.empty() ||
+          lags_move_with_the_step(c.drive_creep_eigenvalues, c.drive_creep_weights));
+}
+
+// An effect is named once per channel, in whichever of its forms fitted first.
+bool named_already(const std::vector<const Candidate*>& used, const Candidate& c) {
+  return std::any_of(used.begin(), used.end(), [&](const Candidate* u) {
+    return std::string_view(u->effect) == std::string_view(c.effect);
+  });
+}
+
+bool is_creep(const Candidate& c) {
+  return uses_term(c, CorrectionTerm::kCreep) || uses_term(c, CorrectionTerm::kDriveCreep);
 }
 
 // The candidate brings a filter whose parameters are not chosen yet.
@@ -503,7 +579,11 @@ std::size_t complexity(const std::vector<CorrectionTerm>& terms) {
         n += 3;
         break;
       case CorrectionTerm::kCreep:
+      case CorrectionTerm::kDriveCreep:
         n += 5;
+        break;
+      case CorrectionTerm::kTemperatureQuadratic:
+        n += 2;
         break;
       case CorrectionTerm::kHysteresis:
         n += 9;  // the linear play and 8 plays (correction_fit.cpp)
@@ -695,7 +775,7 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
     ChannelCorrection best_found;
     double best_bic = -kLocalEvidence;
     for (const Candidate& c : candidates()) {
-      if (std::find(used.begin(), used.end(), &c) != used.end()) continue;
+      if (named_already(used, c)) continue;
       if (!applicable(c, ch, s, !cs.sensed.empty(), charge_drive)) continue;
       // A hysteresis operator fitted to one stretch would bend to anything in it: transients
       // are named by specific physics only.
@@ -707,8 +787,7 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
       } catch (const std::invalid_argument&) {
         continue;  // no finite fit in this stretch
       }
-      if (uses_term(c, CorrectionTerm::kCreep) && !creep_moves_with_the_step(local.correction))
-        continue;
+      if (is_creep(c) && !creep_moves_with_the_step(local.correction)) continue;
       const double after = segment_sse(ch.recorded, local.output, seg);
       const double bic = seg_n * std::log(std::max(after, 1e-300) / before) +
                          static_cast<double>(complexity(c.terms)) * std::log(seg_n);
@@ -756,7 +835,52 @@ void local_pass(const ChannelData& ch, const identification::CorrectionSignals& 
   }
 }
 
+double rms(const std::vector<double>& x) {
+  double sum = 0.0;
+  for (const double v : x)
+    sum += v * v;
+  return x.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(x.size()));
+}
+
+// Where a residual that no candidate reduces lies: the stretches of large moving RMS, and their
+// share of its energy (the whole record when it is spread evenly).
+Unexplained unexplained_in(const std::string& channel, const std::vector<double>& residual,
+                           double noise) {
+  Unexplained u;
+  u.channel = channel;
+  u.residual_rms = rms(residual);
+  u.noise_floor = noise;
+  u.where = large_segments(residual, 1.5, 8);
+  double total = 0.0;
+  for (const double v : residual)
+    total += v * v;
+  double inside = 0.0;
+  for (const Segment& seg : u.where) {
+    for (std::size_t k = seg.begin; k < seg.end; ++k)
+      inside += residual[k] * residual[k];
+  }
+  if (u.where.empty() || !(total > 0.0)) {
+    u.where = {{0, residual.size()}};
+    u.share = 1.0;
+  } else {
+    u.share = inside / total;
+  }
+  return u;
+}
+
 }  // namespace
+
+const char* to_string(Verdict v) noexcept {
+  switch (v) {
+    case Verdict::kMismatch:
+      return "mismatch";
+    case Verdict::kUnexplained:
+      return "unexplained";
+    case Verdict::kConsistent:
+      break;
+  }
+  return "consistent";
+}
 
 Outputs simulate(const models::TransducerModel& model, const Signals& s) {
   models::Simulation sim(model, models::RuntimeOptions{s.sample_time});
@@ -851,10 +975,11 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         std::vector<CorrectionTerm> terms;
         ChannelCorrection start;
         bool levels_judged;  // on held-out holds (hysteresis operators, when needed)
+        bool in_pool{false};
       };
       std::vector<Tried> tried;
       for (const Candidate& c : candidates()) {
-        if (std::find(used.begin(), used.end(), &c) != used.end()) continue;
+        if (named_already(used, c)) continue;
         if (!applicable(c, ch, s, has_sensor, !field)) continue;
         const std::vector<CorrectionTerm> terms = merged(accepted_terms, c.terms);
         ChannelCorrection start = accepted;
@@ -879,14 +1004,12 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
           // A correction that must rescale the model's own output by more than 100 % is a
           // different model, not physics the model left out (re-identify instead).
           if (std::abs(fit.correction.gain) > options.max_gain) continue;
-          if (uses_term(c, CorrectionTerm::kCreep) && !creep_moves_with_the_step(fit.correction))
-            continue;
+          if (is_creep(c) && !creep_moves_with_the_step(fit.correction)) continue;
           const double sse = sse_over(ch.recorded, fit.output, rows.judge);
           const double explains = 1.0 - sse / current_sse;
           const BlockShares shares = block_explains(ch.recorded, current, fit.output, rows);
           HoldJudgement holds;
-          if (uses_term(c, CorrectionTerm::kCreep) && explains >= options.min_explains &&
-              !passes_blocks(shares, options)) {
+          if (is_creep(c) && explains >= options.min_explains && !passes_blocks(shares, options)) {
             holds = judge_on_holds(cs, terms, start, rows, current, drive_holds,
                                    HoldMeasure::kMovement, options);
           }
@@ -927,8 +1050,14 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       const auto competes = [&](const Tried& t) {
         return !t.candidate->generic || 1.0 - t.explains <= options.generic_ratio * specific_left;
       };
-      const auto pool = static_cast<std::size_t>(
-          std::stable_partition(tried.begin(), tried.end(), competes) - tried.begin());
+      // The pool: candidates that compete and are significant, best first (a generic candidate
+      // that fails on the held-out holds leaves the others their chance).
+      for (Tried& t : tried)
+        t.in_pool = competes(t) && significant(t);
+      const auto pool =
+          static_cast<std::size_t>(std::stable_partition(tried.begin(), tried.end(),
+                                                         [](const Tried& t) { return t.in_pool; }) -
+                                   tried.begin());
       if (pool == 0) break;
       // Of the candidates explaining about as much as the best, the simplest.
       std::size_t chosen = 0;
@@ -940,7 +1069,6 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       }
       std::swap(tried[0], tried[chosen]);
       Tried& best = tried.front();
-      if (!significant(best)) break;
 
       Finding f;
       f.effect = best.candidate->effect;
@@ -949,7 +1077,9 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       // removes, so the shares of several findings add up.
       f.explains = original_sse > 0.0 ? best.explains * current_sse / original_sse : 0.0;
       for (std::size_t i = 1; i < tried.size(); ++i) {
+        // Another form of the same effect is not an alternative (the finding names it anyway).
         if (tried[i].explains >= options.alternative_share * best.explains &&
+            std::string_view(tried[i].candidate->effect) != std::string_view(f.effect) &&
             significant(tried[i])) {
           Finding other;
           other.effect = tried[i].candidate->effect;
@@ -991,6 +1121,13 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       residual_after[k] = ch.recorded[k] - current[k];
     }
     out.located = large_segments(residual, 1.5, 8);
+    out.noise_floor = noise_floor(residual);
+    out.residual_rms = rms(residual_after);
+    const bool named = std::any_of(result.findings.begin(), result.findings.end(),
+                                   [&](const Finding& f) { return f.channel == ch.name; });
+    if (!named && out.residual_rms > options.unexplained_ratio * out.noise_floor) {
+      result.unexplained.push_back(unexplained_in(ch.name, residual_after, out.noise_floor));
+    }
     out.test_before = correlation_test(residual, s.drive);
     out.test_after = correlation_test(residual_after, s.drive);
     result.channels.push_back(std::move(out));
@@ -1000,6 +1137,11 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     }
   }
   result.mismatch = !result.findings.empty();
+  if (result.mismatch) {
+    result.verdict = Verdict::kMismatch;
+  } else if (!result.unexplained.empty()) {
+    result.verdict = Verdict::kUnexplained;
+  }
   return result;
 }
 

@@ -20,6 +20,7 @@ double at(std::span<const double> s, std::size_t k, double fallback) noexcept {
 struct Columns {
   std::vector<std::vector<double>> phi{};
   std::vector<double> creep_eigenvalues{};
+  std::vector<double> drive_creep_eigenvalues{};
   std::vector<double> play_thresholds{};
   std::vector<double> hinge_thresholds{};
   std::vector<double> hinge_levels{};
@@ -64,6 +65,35 @@ std::vector<double> log_spaced(double from, double to, std::size_t per_decade) {
   return out;
 }
 
+// One lag per decade from 1/(20 Ts) (at most 1e3 1/s) down to 3 / duration.
+std::vector<double> lag_eigenvalues(std::size_t n, double ts) {
+  const double duration = static_cast<double>(n) * ts;
+  const double fastest = std::min(1.0 / (20.0 * ts), 1.0e3);
+  std::vector<double> out = log_spaced(3.0 / duration, fastest, 1);
+  if (out.size() > models::kMaxCorrectionCreep) {
+    out.erase(out.begin(), out.end() - static_cast<std::ptrdiff_t>(models::kMaxCorrectionCreep));
+  }
+  return out;
+}
+
+// First-order lags of a signal, z[k] = z[k-1] + (1 - exp(-lambda Ts)) (v[k] - z[k-1]) from
+// z = v[0], each minus v[0]: one column per eigenvalue.
+template <typename Value>
+void add_lags(Columns& c, std::size_t n, double ts, const std::vector<double>& eigenvalues,
+              Value&& value) {
+  const double v0 = value(0);
+  for (const double lambda : eigenvalues) {
+    const double a = -std::expm1(-lambda * ts);
+    std::vector<double> col(n);
+    double z = v0;
+    for (std::size_t k = 0; k < n; ++k) {
+      z += a * (value(k) - z);
+      col[k] = z - v0;
+    }
+    c.phi.push_back(std::move(col));
+  }
+}
+
 bool has_term(std::span<const CorrectionTerm> terms, CorrectionTerm t) {
   return std::find(terms.begin(), terms.end(), t) != terms.end();
 }
@@ -91,9 +121,28 @@ Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm>
         add([&](std::size_t k) { return dtheta(k); });
         add([&](std::size_t k) { return dtheta(k) * s.drive[k]; });
         break;
+      case CorrectionTerm::kTemperatureQuadratic:
+        add([&](std::size_t k) { return dtheta(k) * dtheta(k) * s.y[k]; });
+        add([&](std::size_t k) { return dtheta(k) * dtheta(k); });
+        break;
       case CorrectionTerm::kStress:
         add([&](std::size_t k) { return at(s.stress, k, 0.0) * at(s.response, k, s.y[k]); });
         break;
+      case CorrectionTerm::kDriveCreep:
+        c.drive_creep_eigenvalues = lag_eigenvalues(n, s.sample_time);
+        add_lags(c, n, s.sample_time, c.drive_creep_eigenvalues,
+                 [&](std::size_t k) { return s.drive[k]; });
+        break;
+      case CorrectionTerm::kDriveIntegral: {
+        std::vector<double> col(n);
+        double q = 0.0;
+        for (std::size_t k = 0; k < n; ++k) {
+          if (k > 0) q += s.sample_time * s.drive[k];
+          col[k] = q;
+        }
+        c.phi.push_back(std::move(col));
+        break;
+      }
       case CorrectionTerm::kStressQuadratic:
         add([&](std::size_t k) {
           const double stress = at(s.stress, k, 0.0);
@@ -110,29 +159,11 @@ Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm>
           return d * d;
         });
         break;
-      case CorrectionTerm::kCreep: {
-        // One lag per decade from 1/(20 Ts) (at most 1e3 1/s) down to 3 / duration.
-        const double duration = static_cast<double>(n) * s.sample_time;
-        const double fastest = std::min(1.0 / (20.0 * s.sample_time), 1.0e3);
-        c.creep_eigenvalues = log_spaced(3.0 / duration, fastest, 1);
-        if (c.creep_eigenvalues.size() > models::kMaxCorrectionCreep) {
-          c.creep_eigenvalues.erase(
-              c.creep_eigenvalues.begin(),
-              c.creep_eigenvalues.end() - static_cast<std::ptrdiff_t>(models::kMaxCorrectionCreep));
-        }
-        for (const double lambda : c.creep_eigenvalues) {
-          const double a = -std::expm1(-lambda * s.sample_time);
-          std::vector<double> col(n);
-          const double r0 = at(s.response, 0, s.y[0]);
-          double z = r0;
-          for (std::size_t k = 0; k < n; ++k) {
-            z += a * (at(s.response, k, s.y[k]) - z);
-            col[k] = z - r0;
-          }
-          c.phi.push_back(std::move(col));
-        }
+      case CorrectionTerm::kCreep:
+        c.creep_eigenvalues = lag_eigenvalues(n, s.sample_time);
+        add_lags(c, n, s.sample_time, c.creep_eigenvalues,
+                 [&](std::size_t k) { return at(s.response, k, s.y[k]); });
         break;
-      }
       case CorrectionTerm::kHysteresis:
       case CorrectionTerm::kAsymmetricHysteresis: {
         // The asymmetric bank contains the plain one: one bank when both are asked for.
@@ -187,8 +218,22 @@ void apply_coefficients(std::span<const CorrectionTerm> terms, const Columns& co
         out.temperature_offset_per_k = c[i++];
         out.temperature_drive_per_k = c[i++];
         break;
+      case CorrectionTerm::kTemperatureQuadratic:
+        out.temperature_gain_per_k2 = c[i++];
+        out.temperature_offset_per_k2 = c[i++];
+        break;
       case CorrectionTerm::kStress:
         out.stress_gain_per_pa = c[i++];
+        break;
+      case CorrectionTerm::kDriveCreep:
+        out.drive_creep_eigenvalues = columns.drive_creep_eigenvalues;
+        out.drive_creep_weights.clear();
+        for (std::size_t j = 0; j < columns.drive_creep_eigenvalues.size(); ++j) {
+          out.drive_creep_weights.push_back(c[i++]);
+        }
+        break;
+      case CorrectionTerm::kDriveIntegral:
+        out.drive_integral_per_s = c[i++];
         break;
       case CorrectionTerm::kStressQuadratic:
         out.stress_quadratic_per_pa2 = c[i++];

@@ -126,13 +126,16 @@ std::optional<InputRange> read_range(YamlMap& map, std::string_view key) {
 // The scalar keys of a correction (channel_correction.hpp), shared by reading and writing.
 template <typename C>
 auto correction_scalars(C& c) {
-  return std::array<std::pair<const char*, decltype(&c.gain)>, 16>{{
+  return std::array<std::pair<const char*, decltype(&c.gain)>, 19>{{
       {"gain", &c.gain},
       {"offset", &c.offset},
       {"temperature_reference_degc", &c.temperature_reference_degc},
       {"temperature_gain_per_k", &c.temperature_gain_per_k},
       {"temperature_offset_per_k", &c.temperature_offset_per_k},
       {"temperature_drive_per_k", &c.temperature_drive_per_k},
+      {"temperature_gain_per_k2", &c.temperature_gain_per_k2},
+      {"temperature_offset_per_k2", &c.temperature_offset_per_k2},
+      {"drive_integral_per_s", &c.drive_integral_per_s},
       {"stress_gain_per_pa", &c.stress_gain_per_pa},
       {"stress_quadratic_per_pa2", &c.stress_quadratic_per_pa2},
       {"drive_quadratic", &c.drive_quadratic},
@@ -166,6 +169,10 @@ std::optional<ChannelCorrection> read_correction(YamlMap& corrections, std::stri
     m->read(name, *field);
   if (m->has("creep_eigenvalues")) m->read_sequence("creep_eigenvalues", c.creep_eigenvalues);
   if (m->has("creep_weights")) m->read_sequence("creep_weights", c.creep_weights);
+  if (m->has("drive_creep_eigenvalues")) {
+    m->read_sequence("drive_creep_eigenvalues", c.drive_creep_eigenvalues);
+  }
+  if (m->has("drive_creep_weights")) m->read_sequence("drive_creep_weights", c.drive_creep_weights);
   for (const auto& [name, field] : correction_sequences(c)) {
     if (m->has(name)) m->read_sequence(name, *field);
   }
@@ -313,6 +320,10 @@ void emit_correction(YAML::Emitter& out, const char* key, const ChannelCorrectio
   if (!c.creep_eigenvalues.empty()) {
     emit_sequence(out, "creep_eigenvalues", c.creep_eigenvalues);
     emit_sequence(out, "creep_weights", c.creep_weights);
+  }
+  if (!c.drive_creep_eigenvalues.empty()) {
+    emit_sequence(out, "drive_creep_eigenvalues", c.drive_creep_eigenvalues);
+    emit_sequence(out, "drive_creep_weights", c.drive_creep_weights);
   }
   for (const auto& [name, field] : correction_sequences(c)) {
     if (!field->empty()) emit_sequence(out, name, *field);

@@ -23,6 +23,9 @@ bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) co
       {"temperature_gain_per_k", temperature_gain_per_k},
       {"temperature_offset_per_k", temperature_offset_per_k},
       {"temperature_drive_per_k", temperature_drive_per_k},
+      {"temperature_gain_per_k2", temperature_gain_per_k2},
+      {"temperature_offset_per_k2", temperature_offset_per_k2},
+      {"drive_integral_per_s", drive_integral_per_s},
       {"stress_gain_per_pa", stress_gain_per_pa},
       {"stress_quadratic_per_pa2", stress_quadratic_per_pa2},
       {"drive_quadratic", drive_quadratic},
@@ -49,6 +52,21 @@ bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) co
     }
     if (!std::isfinite(creep_weights[i])) {
       return fail(why, prefix + ".creep_weights[" + std::to_string(i) + "]: must be finite");
+    }
+  }
+  if (drive_creep_weights.size() != drive_creep_eigenvalues.size()) {
+    return fail(why, prefix + ".drive_creep_weights: needs one weight per eigenvalue");
+  }
+  if (drive_creep_eigenvalues.size() > kMaxCorrectionCreep) {
+    return fail(why, prefix + ".drive_creep_eigenvalues: at most " +
+                         std::to_string(kMaxCorrectionCreep) + " terms");
+  }
+  for (std::size_t i = 0; i < drive_creep_eigenvalues.size(); ++i) {
+    if (!(std::isfinite(drive_creep_eigenvalues[i]) && drive_creep_eigenvalues[i] > 0.0)) {
+      return fail(why, prefix + ".drive_creep_eigenvalues[" + std::to_string(i) + "]: must be > 0");
+    }
+    if (!std::isfinite(drive_creep_weights[i])) {
+      return fail(why, prefix + ".drive_creep_weights[" + std::to_string(i) + "]: must be finite");
     }
   }
   if (dynamics_frequency_hz < 0.0) {
@@ -127,10 +145,12 @@ bool ChannelCorrection::invertible(const std::string& prefix, std::string* why) 
 bool ChannelCorrection::empty() const noexcept {
   return gain == 0.0 && offset == 0.0 && temperature_gain_per_k == 0.0 &&
          temperature_offset_per_k == 0.0 && temperature_drive_per_k == 0.0 &&
-         stress_gain_per_pa == 0.0 && stress_quadratic_per_pa2 == 0.0 && drive_quadratic == 0.0 &&
-         drive_cubic == 0.0 && drive_linear == 0.0 && sensed_quadratic == 0.0 &&
-         creep_weights.empty() && dynamics_frequency_hz == 0.0 && leakage_tau_s == 0.0 &&
-         delay_s == 0.0 && hysteresis_weights.empty() && hinge_weights.empty();
+         temperature_gain_per_k2 == 0.0 && temperature_offset_per_k2 == 0.0 &&
+         drive_integral_per_s == 0.0 && drive_creep_weights.empty() && stress_gain_per_pa == 0.0 &&
+         stress_quadratic_per_pa2 == 0.0 && drive_quadratic == 0.0 && drive_cubic == 0.0 &&
+         drive_linear == 0.0 && sensed_quadratic == 0.0 && creep_weights.empty() &&
+         dynamics_frequency_hz == 0.0 && leakage_tau_s == 0.0 && delay_s == 0.0 &&
+         hysteresis_weights.empty() && hinge_weights.empty();
 }
 
 CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sample_time)
@@ -139,6 +159,11 @@ CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sam
   if (!c_.is_valid("correction", &why)) throw std::invalid_argument(why);
   if (!(sample_time > 0.0)) throw std::invalid_argument("correction: sample time must be > 0");
   creep_count_ = c_.creep_eigenvalues.size();
+  drive_creep_count_ = c_.drive_creep_eigenvalues.size();
+  ts_ = sample_time;
+  for (std::size_t j = 0; j < drive_creep_count_; ++j) {
+    drive_alpha_[j] = -std::expm1(-c_.drive_creep_eigenvalues[j] * sample_time);
+  }
   play_count_ = c_.hysteresis_thresholds.size();
   std::copy(c_.hysteresis_thresholds.begin(), c_.hysteresis_thresholds.end(), play_r_.begin() + 1);
   hinge_count_ = c_.hinge_thresholds.size();
@@ -189,13 +214,18 @@ CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sam
 // the sign or divide by zero far outside them.
 double CorrectionStage::gain_at(const Inputs& in) const noexcept {
   const double dtheta = in.temperature - c_.temperature_reference_degc;
-  return std::max(1.0 + c_.gain + c_.temperature_gain_per_k * dtheta, 0.05);
+  return std::max(
+      1.0 + c_.gain + (c_.temperature_gain_per_k + c_.temperature_gain_per_k2 * dtheta) * dtheta,
+      0.05);
 }
 
 double CorrectionStage::terms(const Inputs& in) const noexcept {
   const double dtheta = in.temperature - c_.temperature_reference_degc;
   const double x = in.drive;
-  return c_.offset + (c_.temperature_offset_per_k + c_.temperature_drive_per_k * x) * dtheta +
+  return c_.offset +
+         (c_.temperature_offset_per_k + c_.temperature_drive_per_k * x +
+          c_.temperature_offset_per_k2 * dtheta) *
+             dtheta +
          c_.drive_linear * x + c_.drive_quadratic * x * x + c_.drive_cubic * x * x * x +
          c_.sensed_quadratic * in.sensed * in.sensed;
 }
@@ -253,6 +283,24 @@ double CorrectionStage::play_terms(double drive) noexcept {
   return sum;
 }
 
+double CorrectionStage::drive_memory_terms(double drive) noexcept {
+  if (drive_creep_count_ == 0 && c_.drive_integral_per_s == 0.0) return 0.0;
+  if (!memory_started_) {
+    memory_started_ = true;
+    x0_ = drive;
+    u_.fill(drive);
+    integral_ = 0.0;
+  } else {
+    integral_ += ts_ * drive;
+  }
+  double sum = c_.drive_integral_per_s * integral_;
+  for (std::size_t j = 0; j < drive_creep_count_; ++j) {
+    u_[j] += drive_alpha_[j] * (drive - u_[j]);
+    sum += c_.drive_creep_weights[j] * (u_[j] - x0_);
+  }
+  return sum;
+}
+
 double CorrectionStage::step(const Inputs& in) noexcept {
   const bool first = !started_;
   if (first) {
@@ -262,7 +310,8 @@ double CorrectionStage::step(const Inputs& in) noexcept {
       z_[j] = in.response;
   }
   double v = in.y * gain_at(in) + c_.stress_gain_per_pa * in.stress * in.response +
-             c_.stress_quadratic_per_pa2 * in.stress * in.stress + terms(in) + play_terms(in.drive);
+             c_.stress_quadratic_per_pa2 * in.stress * in.stress + terms(in) +
+             play_terms(in.drive) + drive_memory_terms(in.drive);
   for (std::size_t j = 0; j < creep_count_; ++j) {
     z_[j] += alpha_[j] * (in.response - z_[j]);
     v += c_.creep_weights[j] * (z_[j] - y0_);
@@ -304,7 +353,8 @@ double CorrectionStage::invert(double measured, const Inputs& in) noexcept {
     z_[j] += alpha_[j] * (in.response - z_[j]);
     creep += c_.creep_weights[j] * (z_[j] - y0_);
   }
-  return (w - terms(in) - play_terms(in.drive) - creep) / gain_at(in);
+  return (w - terms(in) - play_terms(in.drive) - drive_memory_terms(in.drive) - creep) /
+         gain_at(in);
 }
 
 double CorrectionStage::solve_stress(double t_lin, double coupling,
@@ -319,7 +369,7 @@ double CorrectionStage::solve_stress(double t_lin, double coupling,
 
 void CorrectionStage::save_state(std::span<double> out) const noexcept {
   std::size_t i = 0;
-  const double head[12] = {started_ ? 1.0 : 0.0,
+  const double head[15] = {started_ ? 1.0 : 0.0,
                            y0_,
                            v1_,
                            v2_,
@@ -330,10 +380,15 @@ void CorrectionStage::save_state(std::span<double> out) const noexcept {
                            static_cast<double>(head_),
                            static_cast<double>(drive_head_),
                            drive_started_ ? 1.0 : 0.0,
-                           plays_started_ ? 1.0 : 0.0};
+                           plays_started_ ? 1.0 : 0.0,
+                           memory_started_ ? 1.0 : 0.0,
+                           x0_,
+                           integral_};
   for (const double v : head)
     out[i++] = v;
   for (const double v : z_)
+    out[i++] = v;
+  for (const double v : u_)
     out[i++] = v;
   for (const double v : plays_)
     out[i++] = v;
@@ -357,7 +412,12 @@ void CorrectionStage::restore_state(std::span<const double> in) noexcept {
   drive_head_ = static_cast<std::size_t>(in[i++]) % kLine;
   drive_started_ = in[i++] != 0.0;
   plays_started_ = in[i++] != 0.0;
+  memory_started_ = in[i++] != 0.0;
+  x0_ = in[i++];
+  integral_ = in[i++];
   for (double& v : z_)
+    v = in[i++];
+  for (double& v : u_)
     v = in[i++];
   for (double& v : plays_)
     v = in[i++];

@@ -75,6 +75,15 @@ void add_correction(Fnv1a& h, const std::optional<ChannelCorrection>& c) noexcep
     h.add(c->hinge_weights);
   }
   if (c->drive_linear != 0.0) h.add(c->drive_linear);  // likewise for corrections without it
+  // Terms added later: hashed only when used, so older corrections keep their identity.
+  for (const double x :
+       {c->temperature_gain_per_k2, c->temperature_offset_per_k2, c->drive_integral_per_s}) {
+    if (x != 0.0) h.add(x);
+  }
+  if (!c->drive_creep_eigenvalues.empty()) {
+    h.add(c->drive_creep_eigenvalues);
+    h.add(c->drive_creep_weights);
+  }
 }
 
 void add_vectorial_side(Fnv1a& h, const std::optional<StressHysteresisSide>& side) noexcept {

@@ -23,6 +23,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -56,7 +57,10 @@ struct Options {
   // A candidate whose fit rescales the model's output by more than this (relative) is not one.
   double max_gain{1.0};
   std::size_t max_effects{4};  // per channel
-  std::size_t blocks{10};      // alternate blocks for fitting and judging
+  std::size_t blocks{20};      // alternate blocks for fitting and judging
+  // A residual is "well above the noise floor" when its RMS exceeds this factor of the noise
+  // floor (statistics.hpp): at 5, 96 % of its variance is model error, not sensor noise.
+  double unexplained_ratio{5.0};
 };
 
 // Another effect that explains nearly as much of the same residual, with its own evidence: the
@@ -80,6 +84,8 @@ struct Finding {
 
 struct ChannelResult {
   std::string channel{};
+  double noise_floor{0.0};   // of the residual before (statistics.hpp), channel units
+  double residual_rms{0.0};  // the residual left (after the findings), channel units
   std::vector<double> recorded{};
   std::vector<double> before{};
   std::vector<double> after{};
@@ -88,9 +94,26 @@ struct ChannelResult {
   CorrelationTest test_after{};
 };
 
+// A residual well above the noise floor that no candidate reduces on held-out data: where it is
+// and how much of it that is.
+struct Unexplained {
+  std::string channel{};
+  std::vector<Segment> where{};  // the stretches that hold most of it (or the whole record)
+  double share{0.0};             // of the residual's energy in `where`
+  double residual_rms{0.0};      // channel units
+  double noise_floor{0.0};       // channel units
+};
+
+// mismatch: at least one finding; unexplained: none, but a residual well above the noise floor
+// (Unexplained); consistent: the residual is at the noise floor or nothing significant is left.
+enum class Verdict : std::uint8_t { kConsistent, kMismatch, kUnexplained };
+[[nodiscard]] const char* to_string(Verdict v) noexcept;
+
 struct Result {
   bool mismatch{false};
+  Verdict verdict{Verdict::kConsistent};
   std::vector<Finding> findings{};
+  std::vector<Unexplained> unexplained{};  // channels without a finding whose residual stands out
   std::vector<ChannelResult> channels{};
   models::TransducerModel improved{};
 };

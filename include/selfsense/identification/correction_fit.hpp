@@ -20,13 +20,16 @@
 namespace selfsense::identification {
 
 enum class CorrectionTerm : std::uint8_t {
-  kOffset,           // gain and offset
-  kTemperature,      // gain and offset per kelvin
-  kStress,           // gain per pascal (of the drive response)
-  kStressQuadratic,  // T^2: a stress-dependent coupling seen on the sensed channel
+  kOffset,                // gain and offset
+  kTemperature,           // gain and offset per kelvin
+  kTemperatureQuadratic,  // gain and offset per kelvin squared
+  kStress,                // gain per pascal (of the drive response)
+  kStressQuadratic,       // T^2: a stress-dependent coupling seen on the sensed channel
   kDrivePolynomial,
   kSensedQuadratic,
   kCreep,                 // log-spaced lags of y
+  kDriveCreep,            // log-spaced lags of the drive x
+  kDriveIntegral,         // the integral of the drive (charge through a parallel conductance)
   kHysteresis,            // plays of the drive, p_i - x (8 thresholds up to half its range)
   kAsymmetricHysteresis,  // those plays and hinges on them and on x (3 levels each)
   kDynamics,              // searched: f0, zeta

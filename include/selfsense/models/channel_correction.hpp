@@ -5,11 +5,16 @@
 //         + temperature_gain (theta - theta_ref) y
 //         + temperature_offset (theta - theta_ref)               temperature_dependence
 //         + temperature_drive (theta - theta_ref) x
+//         + temperature_gain2 (theta - theta_ref)^2 y
+//         + temperature_offset2 (theta - theta_ref)^2            (quadratic in the change)
 //         + stress_gain T r + stress_quadratic T^2               stress_dependence
 //         + drive_quadratic x^2 + drive_cubic x^3                permittivity_nonlinearity
 //         + sensed_quadratic s^2                                 electrostriction (S ~ P^2,
 //                                                                P ~ D - d T)
 //         + sum_j creep_weights_j (z_j - r_0)                    creep (eq. 28: K = L[H])
+//         + sum_j drive_creep_weights_j (u_j - x_0)              creep driven by the input
+//         + drive_integral q                                     charge_leakage through the
+//                                                                stack's parallel conductance
 //         + drive_linear x + sum_i hysteresis_weights_i (p_i - x)
 //                                                                hysteresis (a PI operator of
 //                                                                the drive: its linear play and
@@ -18,6 +23,8 @@
 //                                                                on the plays: the Preisach class)
 //   p_i[k] = max(x[k] - r_i, min(x[k] + r_i, p_i[k-1])),  p_i = x at the start (p_0 = x)
 //   z_j[k] = z_j[k-1] + (1 - exp(-lambda_j Ts)) (r[k] - z_j[k-1]),  z_j = r_0 = r at the start
+//   u_j[k] = u_j[k-1] + (1 - exp(-mu_j Ts)) (x[k] - u_j[k-1]),   u_j = x_0 = x at the start
+//   q[k] = q[k-1] + Ts x[k],  q = 0 at the start  (the field's integral [drive unit s])
 //   w = second-order low-pass of v, unity DC gain, f0 and zeta    dynamics
 //       (bilinear transform prewarped at f0)
 //   m[k] = g m[k-1] + c (w[k] - w[k-1]),  g = exp(-Ts/tau), c = (1 - g) tau / Ts,  m = w at the
@@ -27,8 +34,9 @@
 // sensed response to the drive alone (D - d T, d the sensor's coupling), r = y - coupling T the
 // channel's response to the drive alone (so a coupling that changes with stress,
 // d(T) = d (1 + k T), is k T r on S and d k T^2 on D). Units: gain, temperature_gain [1/K],
-// stress_gain [1/Pa] relative; offset, drive_linear and the polynomial terms in the channel's
-// unit (per unit of the drive to its power).
+// stress_gain [1/Pa] relative, temperature_gain2 [1/K^2]; offset, drive_linear and the
+// polynomial terms in the channel's unit (per unit of the drive to its power); drive_integral in
+// the channel's unit per (drive unit s): for D under field drive the conductivity [S/m].
 //
 // Reconstruction needs the inverse on the sensed channel: the leakage is undone
 // (w[k] = w[k-1] + (m[k] - g m[k-1]) / c), a delay moves to the drive, and the additive and
@@ -59,6 +67,9 @@ struct ChannelCorrection {
   double temperature_gain_per_k{0.0};
   double temperature_offset_per_k{0.0};
   double temperature_drive_per_k{0.0};
+  double temperature_gain_per_k2{0.0};
+  double temperature_offset_per_k2{0.0};
+  double drive_integral_per_s{0.0};  // charge lost through a parallel conductance
   double stress_gain_per_pa{0.0};
   double stress_quadratic_per_pa2{0.0};
   double drive_quadratic{0.0};
@@ -67,6 +78,8 @@ struct ChannelCorrection {
   double sensed_quadratic{0.0};
   std::vector<double> creep_eigenvalues{};  // [1/s]
   std::vector<double> creep_weights{};
+  std::vector<double> drive_creep_eigenvalues{};  // [1/s] (mu_j)
+  std::vector<double> drive_creep_weights{};
   double dynamics_frequency_hz{0.0};  // 0: none
   double dynamics_damping{0.0};
   double leakage_tau_s{0.0};                    // 0: none
@@ -130,12 +143,14 @@ class CorrectionStage {
  private:
   static constexpr std::size_t kLine = kMaxCorrectionDelaySamples + 2;
   static constexpr std::size_t kStateSize =
-      12 + kMaxCorrectionCreep + kMaxCorrectionPlays + 2 * kLine;
+      15 + 2 * kMaxCorrectionCreep + kMaxCorrectionPlays + 2 * kLine;
 
   double terms(const Inputs& in) const noexcept;  // the additive/gain terms except creep
   double gain_at(const Inputs& in) const noexcept;
   double filters(double v) noexcept;         // dynamics, leakage, delay
   double play_terms(double drive) noexcept;  // advances the plays; hysteresis + hinge terms
+  // Advances the drive's lags and integral; their terms.
+  double drive_memory_terms(double drive) noexcept;
   double delayed(double value) noexcept;
   double push_delayed(std::array<double, kLine>& line, std::size_t& head,
                       double value) const noexcept;
@@ -143,6 +158,9 @@ class CorrectionStage {
   ChannelCorrection c_;
   std::array<double, kMaxCorrectionCreep> alpha_{};  // 1 - exp(-lambda Ts)
   std::size_t creep_count_{0};
+  std::array<double, kMaxCorrectionCreep> drive_alpha_{};  // 1 - exp(-mu Ts)
+  std::size_t drive_creep_count_{0};
+  double ts_{0.0};
   // Dynamics: w[k] = b0 v[k] + b1 v[k-1] + b2 v[k-2] - a1 w[k-1] - a2 w[k-2].
   double b0_{1.0}, b1_{0.0}, b2_{0.0}, a1_{0.0}, a2_{0.0};
   double leak_g_{0.0}, leak_c_{1.0};
@@ -153,7 +171,12 @@ class CorrectionStage {
   std::array<std::size_t, kMaxCorrectionHinges> hinge_row_{};
   std::size_t hinge_count_{0};
   // State (saved in this order): started, y0, v1, v2, w1, w2, m, w_prev, head, drive_head,
-  // drive_started, plays_started; creep z; plays; the output and drive delay lines (rings).
+  // drive_started, plays_started, memory_started, x0, integral; creep z; drive lags u; plays;
+  // the output and drive delay lines (rings).
+  bool memory_started_{false};
+  double x0_{0.0};
+  double integral_{0.0};
+  std::array<double, kMaxCorrectionCreep> u_{};
   double y0_{0.0};
   double v1_{0.0}, v2_{0.0}, w1_{0.0}, w2_{0.0};
   double m_{0.0}, w_prev_{0.0};
