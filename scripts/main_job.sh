@@ -6,6 +6,10 @@
 # feedback on S_hat. For each, from the daemon's own recording, the tracking error of S_hat (or
 # T_hat) and of the plant's true S (or T) against the setpoint, or the ring-down times; an HTML
 # page with the plots; a clean stop of each daemon.
+# Each run watches the daemon's state (scripts/daemon_runs.sh): a run in which the loop faults
+# is reported (fault, cycle, time, cause; OUT_DIR/faults.txt) and done again once; a second
+# fault ends the job with exit 1 and no figures. The figures count armed samples only
+# (scripts/main_job_report.sh).
 #   scripts/main_job.sh BUILD_DIR OUT_DIR
 # SELFSENSE_MAIN_JOB_CONFIG: another configuration of config/ for the first part (e.g.
 # config/modbus-sim.yaml through scripts/modbus_main_job.sh), which then skips the damping run
@@ -18,10 +22,14 @@ cli=$build/src/cli/selfsense
 daemon=$build/src/selfsensed/selfsensed
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
+run_dir=$out
+rm -f "$out/faults.txt"
+# shellcheck source=scripts/daemon_runs.sh
+source "$root/scripts/daemon_runs.sh"
 
 # start_daemon SHIPPED_CONFIG: the configuration with this run's paths (beside the shipped one,
 # so its relative paths resolve), checked, and selfsensed started on it; waits for its socket.
-config=$root/config/.main-job.yaml
+config=$root/config/.main-job-$$.yaml
 pid=
 start_daemon() {
   sed -e "s|directory: ../build/[a-z-]*/recordings|directory: $out/recordings|" \
@@ -36,6 +44,10 @@ start_daemon() {
     [ -S "$out/control.sock" ] && break
     sleep 0.1
   done
+  [ -S "$out/control.sock" ] || {
+    echo "FAILED: selfsensed did not open $out/control.sock: $(tail -5 "$out/daemon.log")" >&2
+    exit 1
+  }
 }
 # stop_daemon: SIGTERM, its exit status printed (the end-to-end test checks it).
 stop_daemon() {
@@ -52,42 +64,34 @@ cleanup() {
 }
 trap cleanup EXIT
 ctl() { "$cli" ctl --socket "$out/control.sock" "$@"; }
-value() { sed -n "s/.*\"$1\":\([^,}]*\).*/\1/p"; }
 
 start_daemon "${SELFSENSE_MAIN_JOB_CONFIG:-$root/config/sim.yaml}"
 
-# segment NAME MODE: one recording per segment.
-segment_start() {
-  ctl disarm >/dev/null 2>&1 || true
-  ctl mode "$2" >/dev/null
-  ctl reset >/dev/null 2>&1 || true
-  sleep 0.3
-  ctl arm >/dev/null
-  ctl record start | value path | tr -d '"' >"$out/$1.path"
+# The runs (watched_run NAME MODE RUN: armed in MODE, RUN NAME records and holds).
+position_run() {
+  record_start "$1"
+  local level
+  for level in 1.5e-4 6.0e-4 1.05e-3 3.5e-4 8.0e-4; do
+    ctl setpoint "$level" >/dev/null
+    hold 0.8
+  done
+  ctl wave sine --amplitude 4.5e-4 --offset 6.0e-4 --frequency 1 --repeat 3 >/dev/null
+  hold 3.2
 }
-segment_stop() {
-  ctl record stop >/dev/null
-  ctl disarm >/dev/null || true
-  echo "$1: $(cat "$out/$1.path")"
+force_run() {
+  record_start "$1"
+  local level
+  for level in -5.0e6 -8.0e6 -6.0e6; do
+    ctl setpoint "$level" >/dev/null
+    hold 0.8
+  done
 }
 
 echo "== position: staircase over 80 % of the stroke, then a 1 Hz sine"
-segment_start position position
-for level in 1.5e-4 6.0e-4 1.05e-3 3.5e-4 8.0e-4; do
-  ctl setpoint "$level" >/dev/null
-  sleep 0.8
-done
-ctl wave sine --amplitude 4.5e-4 --offset 6.0e-4 --frequency 1 --repeat 3 >/dev/null
-sleep 3.2
-segment_stop position
+watched_run position position position_run
 
 echo "== force: steps of compressive stress"
-segment_start force force
-for level in -5.0e6 -8.0e6 -6.0e6; do
-  ctl setpoint "$level" >/dev/null
-  sleep 0.8
-done
-segment_stop force
+watched_run force force force_run
 
 ctl status --pretty >"$out/status.json"
 stop_daemon
@@ -96,21 +100,17 @@ segments=(position force)
 if [ -z "${SELFSENSE_MAIN_JOB_CONFIG:-}" ]; then
   echo "== damping: a 300 N impulse of 0.5 ms on a 300 Hz mount, in open loop, then with PPF on S_hat"
   start_daemon "$root/config/damping-sim.yaml"
-  for run in open-loop:undamped damping:damped; do
-    # Recorded from rest: armed, settled on the setpoint, then the impulse.
-    ctl disarm >/dev/null 2>&1 || true
-    ctl mode "${run%%:*}" >/dev/null
-    ctl reset >/dev/null 2>&1 || true
-    sleep 0.3
-    ctl arm >/dev/null
+  # Recorded from rest: armed, settled on the setpoint, then the impulse.
+  damping_run() {
     ctl setpoint 6.0e-4 >/dev/null
-    sleep 0.6
-    ctl record start | value path | tr -d '"' >"$out/${run#*:}.path"
-    sleep 0.1
+    hold 0.6
+    record_start "$1"
+    hold 0.1
     ctl impulse 300 --duration 5e-4 >/dev/null
-    sleep 0.6
-    segment_stop "${run#*:}"
-  done
+    hold 0.6
+  }
+  watched_run undamped open-loop damping_run
+  watched_run damped damping damping_run
   stop_daemon
   segments+=(undamped damped)
 fi

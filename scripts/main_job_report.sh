@@ -5,23 +5,57 @@
 # damping run's segments (undamped, damped) the ring-down after the impulse: the time from the
 # largest deviation of true S (and of S_hat) from its rest to the last sample outside 5 % of that
 # deviation, the rest being the mean of the recording's last 40 %. An HTML page with an inline
-# SVG plot per segment.
+# SVG plot per segment, and the faulted runs the main job repeated (OUT_DIR/faults.txt).
+# Figures count the samples of the armed state only (the recording's `state` column); each line
+# says how many others it excluded. A recording in which the loop faulted gets no figure: a line
+# naming the fault's time, cycle and faults instead, and the exit status is 1 once the page is
+# written.
 #   scripts/main_job_report.sh OUT_DIR SEGMENT...   (SEGMENT.path holds its recording's path)
 set -euo pipefail
 out=${1:?usage: scripts/main_job_report.sh OUT_DIR SEGMENT...}
 shift
 html=$out/main_job.html
+rm -f "$out/figures.txt"
 {
   echo '<!doctype html><html><head><meta charset="utf-8"><title>selfsense main job</title>'
   echo '<style>body{font-family:sans-serif;margin:2em}svg{border:1px solid #ccc}</style></head><body>'
   echo '<h1>selfsensed on the simulated transducer</h1>'
+  if [ -s "$out/faults.txt" ]; then
+    echo '<h2>faulted runs, done again</h2><ul>'
+    sed -e 's/&/\&amp;/g' -e 's/</\&lt;/g' -e 's/^/<li>/' -e 's|$|</li>|' "$out/faults.txt"
+    echo '</ul>'
+  fi
 } >"$html"
+# The armed samples of a recording (awk, before the segment's own rules): `state` 2 is armed;
+# others are counted in `excluded`, the first faulted one (state 0) kept: its t, cycle, faults.
+armed_only='
+  function fault_names(bits,   i, s) {
+    split("power_up driver_error driver_timeout stale_sample input_not_finite input_out_of_range estimate_out_of_range reconstruction overrun watchdog amplifier_fault", fault_name, " ")
+    for (i = 1; i <= 11; i++) if (int(bits / 2 ^ (i - 1)) % 2) s = s (s == "" ? "" : ", ") fault_name[i]
+    return s == "" ? "none latched" : s
+  }
+  /^#/ { next }
+  !header { for (i = 1; i <= NF; i++) col[$i] = i; header = 1; next }
+  $col["state"] != 2 {
+    excluded++
+    if ($col["state"] == 0 && !faulted++) { fault_t = $col["t"]; fault_cycle = $col["cycle"]; fault_bits = $col["faults"] }
+    next
+  }
+  # no_figure(): true (and a line said why) when the recording faulted or has no armed sample.
+  function no_figure(seg, n) {
+    if (faulted) {
+      printf "%s: no figure: the loop faulted at t = %.10g s (cycle %d: %s); %d of %d samples outside the armed state\n",
+             seg, fault_t, fault_cycle, fault_names(fault_bits), excluded, n + excluded
+      return 1
+    }
+    if (n == 0) { printf "%s: no figure: no sample in the armed state (%d outside it)\n", seg, excluded; return 1 }
+    return 0
+  }
+'
 # ring_down SEGMENT FILE: figures line on stdout, the plot (S - rest over 0.4 s from 0.05 s before
 # the peak, true S red, S_hat blue) in OUT/SEGMENT.svg.
 ring_down() {
-  awk -F, -v seg="$1" -v svg="$out/$1.svg" '
-    /^#/ { next }
-    !header { for (i = 1; i <= NF; i++) col[$i] = i; header = 1; next }
+  awk -F, -v seg="$1" -v svg="$out/$1.svg" "$armed_only"'
     { n++; t[n] = $col["t"]; x[n] = $col["S"]; h[n] = $col["S_hat"] }
     function rest(v,   i, m, s) { for (i = int(0.6 * n); i <= n; i++) { s += v[i]; m++ } return s / m }
     function ring(v, base,   i, d, peak, at, last) {
@@ -33,10 +67,11 @@ ring_down() {
       return t[last] - t[at]
     }
     END {
+      if (no_figure(seg, n)) exit 1
       bx = rest(x); bh = rest(h)
       rh = ring(h, bh); rx = ring(x, bx); peak = PEAK; at = AT
-      printf "%s: %d samples, peak deviation of true S %.3g, ring-down to 5 %%: true S %.1f ms, S_hat %.1f ms\n",
-             seg, n, peak, 1000 * rx, 1000 * rh
+      printf "%s: %d armed samples (%d outside the armed state excluded), peak deviation of true S %.3g, ring-down to 5 %%: true S %.1f ms, S_hat %.1f ms\n",
+             seg, n, excluded, peak, 1000 * rx, 1000 * rh
       W = 900; H = 300; t0 = t[at] - 0.05; t1 = t0 + 0.4
       printf "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\">\n", W, H > svg
       for (k = 1; k <= 2; k++) {
@@ -52,24 +87,25 @@ ring_down() {
     }' "$2"
 }
 
+faulted=0
 for segment in "$@"; do
   file=$(cat "$out/$segment.path")
+  rm -f "$out/$segment.svg"
   if [ "$segment" = undamped ] || [ "$segment" = damped ]; then
-    ring_down "$segment" "$file" | tee -a "$out/figures.txt"
+    ring_down "$segment" "$file" | tee -a "$out/figures.txt" || faulted=1
     {
       echo "<h2>damping run: $segment</h2><p>$(tail -1 "$out/figures.txt")</p>"
       echo "<p>S minus its rest after a 300 N impulse of 0.5 ms, 0.4 s from 0.05 s before the peak; red: true S, blue: S_hat (the signal the loop damps)</p>"
-      cat "$out/$segment.svg"
+      [ ! -f "$out/$segment.svg" ] || cat "$out/$segment.svg"
     } >>"$html"
     continue
   fi
   # position: S_hat and S; force: T_hat and T.
   if [ "$segment" = force ]; then hat=T_hat truth=T unit=Pa; else hat=S_hat truth=S unit=-; fi
-  awk -F, -v hat="$hat" -v truth="$truth" -v seg="$segment" -v unit="$unit" -v svg="$out/$segment.svg" '
-    /^#/ { next }
-    !header { for (i = 1; i <= NF; i++) col[$i] = i; header = 1; next }
+  awk -F, -v hat="$hat" -v truth="$truth" -v seg="$segment" -v unit="$unit" -v svg="$out/$segment.svg" "$armed_only"'
     { n++; t[n] = $col["t"]; r[n] = $col["setpoint"]; h[n] = $col[hat]; x[n] = $col[truth] }
     END {
+      if (no_figure(seg, n)) exit 1
       lo = hi = r[1]; last_jump = t[1]
       for (i = 1; i <= n; i++) { if (r[i] < lo) lo = r[i]; if (r[i] > hi) hi = r[i] }
       range = hi - lo
@@ -78,8 +114,8 @@ for segment in "$@"; do
         if (t[i] - last_jump < 0.2) continue
         m++; eh += (h[i] - r[i]) ^ 2; ex += (x[i] - r[i]) ^ 2
       }
-      printf "%s: %d samples (%d settled), setpoint range %.4g %s: %s %.3f %% RMS, true %s %.3f %% RMS\n",
-             seg, n, m, range, unit, hat, 100 * sqrt(eh / m) / range, truth, 100 * sqrt(ex / m) / range
+      printf "%s: %d armed samples (%d settled; %d outside the armed state excluded), setpoint range %.4g %s: %s %.3f %% RMS, true %s %.3f %% RMS\n",
+             seg, n, m, excluded, range, unit, hat, 100 * sqrt(eh / m) / range, truth, 100 * sqrt(ex / m) / range
       # plot: setpoint black, estimate blue, truth red; about 1500 points
       W = 900; H = 300; step = int(n / 1500) + 1
       ylo = lo - 0.1 * range; yhi = hi + 0.1 * range
@@ -94,14 +130,14 @@ for segment in "$@"; do
         print "\"/>" > svg
       }
       print "</svg>" > svg
-    }' "$file" | tee -a "$out/figures.txt"
+    }' "$file" | tee -a "$out/figures.txt" || faulted=1
   {
     echo "<h2>$segment</h2><p>$(tail -1 "$out/figures.txt")</p>"
     echo "<p>black: setpoint, blue: $hat (self-sensed), red: $truth (the plant's truth, never seen by the loop)</p>"
-    cat "$out/$segment.svg"
+    [ ! -f "$out/$segment.svg" ] || cat "$out/$segment.svg"
   } >>"$html"
 done
-if grep -q '^undamped: ' "$out/figures.txt" && grep -q '^damped: ' "$out/figures.txt"; then
+if grep -q '^undamped: .* ring-down to 5' "$out/figures.txt" && grep -q '^damped: .* ring-down to 5' "$out/figures.txt"; then
   ms() { sed -n "s/^$1: .* true S \([0-9.]*\) ms, S_hat \([0-9.]*\) ms/\\$2/p" "$out/figures.txt"; }
   awk -v ux="$(ms undamped 1)" -v dx="$(ms damped 1)" -v uh="$(ms undamped 2)" -v dh="$(ms damped 2)" \
     'BEGIN { printf "damping: ring-down shortened %.1fx on true S, %.1fx on S_hat (goal 10x)\n", ux / dx, uh / dh }' |
@@ -110,3 +146,4 @@ if grep -q '^undamped: ' "$out/figures.txt" && grep -q '^damped: ' "$out/figures
 fi
 echo '</body></html>' >>"$html"
 echo "wrote $html"
+[ "$faulted" = 0 ] || { echo "a recording has faulted samples: no figure for it" >&2; exit 1; }

@@ -70,13 +70,33 @@ nlohmann::json ControlHandler::status() {
   const runtime::StatusSnapshot s = daemon_->status();
   nlohmann::json faults = nlohmann::json::array();
   nlohmann::json fault_details = nlohmann::json::object();
+  const double rate_hz = daemon_->config().loop.rate_hz;
+  const runtime::OverrunPolicy& overrun = daemon_->config().safety.overrun;
+  const auto cause = [&overrun](runtime::Fault f) {
+    std::string text(runtime::cause_of(f));
+    if (f == runtime::Fault::kOverrun) {
+      text += " (" + std::to_string(overrun.consecutive) + " in a row";
+      if (overrun.within_count > 0) {
+        text += ", or " + std::to_string(overrun.within_count) + " within " +
+                std::to_string(overrun.window) + " cycles";
+      }
+      text += ")";
+    }
+    return text;
+  };
   for (std::size_t i = 0; i < runtime::kFaultCount; ++i) {
     const auto f = static_cast<runtime::Fault>(i);
     const runtime::FaultRecord& r = s.fault_records[i];
     if ((s.faults & runtime::bit(f)) != 0U) faults.push_back(std::string(runtime::to_string(f)));
     if (r.count > 0) {
+      // The loop's time of those cycles (a recording's t), and what the fault means.
       fault_details[std::string(runtime::to_string(f))] = {
-          {"count", r.count}, {"first_cycle", r.first_cycle}, {"last_cycle", r.last_cycle}};
+          {"count", r.count},
+          {"first_cycle", r.first_cycle},
+          {"last_cycle", r.last_cycle},
+          {"first_s", static_cast<double>(r.first_cycle) / rate_hz},
+          {"last_s", static_cast<double>(r.last_cycle) / rate_hz},
+          {"cause", cause(f)}};
     }
   }
   const RecorderCounters rec = daemon_->recorder().counters();

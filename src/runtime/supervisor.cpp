@@ -15,16 +15,31 @@ std::string_view to_string(Fault f) noexcept {
   return i < kNames.size() ? kNames[i] : std::string_view("unknown");
 }
 
+std::string_view cause_of(Fault f) noexcept {
+  constexpr std::array<std::string_view, kFaultCount> kCauses{
+      "started: a reset is required before arming",
+      "the driver reported an error, bad data or a device fault",
+      "no sample in time, or the device is disconnected",
+      "the sample repeats the last one (stuck converter or missed data-ready)",
+      "E or D is not finite",
+      "E or D outside the model's range",
+      "T_hat or S_hat outside safety.stress_range_pa or safety.strain_range",
+      "the model found no unique solution",
+      "the loop missed its deadlines beyond safety.overrun",
+      "armed on socket setpoints and none arrived within safety.watchdog_s",
+      "the amplifier's fault line"};
+  const auto i = static_cast<std::size_t>(f);
+  return i < kCauses.size() ? kCauses[i] : std::string_view("unknown");
+}
+
 bool OverrunPolicy::is_valid(std::string* why) const {
   const auto fail = [why](const char* message) {
     if (why != nullptr) *why = message;
     return false;
   };
   if (consecutive < 1) return fail("safety.overrun.consecutive: must be >= 1");
-  if (within_count < 1 || within_count > 64) {
-    return fail("safety.overrun.within_count: must be in [1, 64]");
-  }
-  if (window < within_count) return fail("safety.overrun.window: must be >= within_count");
+  if (within_count > 64) return fail("safety.overrun.within_count: must be in [0, 64]");
+  if (window < within_count) return fail("safety.overrun.window_cycles: must be >= within_count");
   return true;
 }
 
@@ -53,10 +68,14 @@ void Supervisor::note_cycle(bool overrun, std::int64_t cycle, std::int64_t misse
       std::min<std::int64_t>(in_row, std::numeric_limits<std::uint32_t>::max()));
   recent_[recent_next_] = cycle;
   recent_next_ = (recent_next_ + 1) % recent_.size();
-  // The within_count-th most recent overrun, still inside the window?
-  const std::size_t back = (recent_next_ + recent_.size() - policy_.within_count) % recent_.size();
-  const std::int64_t oldest = recent_[back];
-  const bool dense = oldest >= 0 && cycle - oldest < static_cast<std::int64_t>(policy_.window);
+  // The within_count-th most recent overrun, still inside the window? (within_count 0: off)
+  bool dense = false;
+  if (policy_.within_count > 0) {
+    const std::size_t back =
+        (recent_next_ + recent_.size() - policy_.within_count) % recent_.size();
+    const std::int64_t oldest = recent_[back];
+    dense = oldest >= 0 && cycle - oldest < static_cast<std::int64_t>(policy_.window);
+  }
   if (consecutive_ >= policy_.consecutive || dense) report(Fault::kOverrun, cycle);
 }
 

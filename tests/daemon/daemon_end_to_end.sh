@@ -2,7 +2,9 @@
 # selfsensed end to end on the simulated transducer, paced in real time: the main job
 # (scripts/main_job.sh: position staircase and sine, force steps, through `selfsense ctl`), then
 # its figures, the recordings read back by the tool, a bad configuration refused with its
-# problems named, a reload, and SIGTERM to exit status 0.
+# problems named, a reload, and SIGTERM to exit status 0. The main job watches the loop's state
+# (scripts/daemon_runs.sh): a run that faults (a pause of several ms of a shared machine) is
+# reported and done again once, and only a second fault fails the job and this test.
 #   daemon_end_to_end.sh BUILD_DIR
 set -euo pipefail
 build=${1:?usage: daemon_end_to_end.sh BUILD_DIR}
@@ -12,6 +14,10 @@ trap 'rm -rf "$out"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
 bash "$root/scripts/main_job.sh" "$build" "$out" | tee "$out/main_job.out"
+if [ -s "$out/faults.txt" ]; then
+  echo "note: faulted runs, done again:"
+  cat "$out/faults.txt"
+fi
 [ "$(grep -c 'selfsensed exited with status 0' "$out/main_job.out")" = 2 ] ||
   fail "a selfsensed did not exit 0 on SIGTERM: $(grep 'exited with status' "$out/main_job.out")"
 # Figures (measured: S_hat 0.19 %, true S 0.22 %; T_hat 0.34 %, true T 0.98-1.04 %): the loop holds

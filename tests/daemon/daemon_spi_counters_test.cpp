@@ -102,7 +102,12 @@ TEST(DaemonSpiCounters, CrcErrorsReachTheStatusAndTheTextfile) {
   EXPECT_EQ(c.at("driver_events").size(), 12U);
   EXPECT_GT(c.at("driver_reads").get<long long>(), 100);
   EXPECT_TRUE(c.contains("driver_writes"));
-  EXPECT_GE(status.at("fault_details").at("driver_error").at("count").get<long long>(), 1);
+  const nlohmann::json& fault = status.at("fault_details").at("driver_error");
+  EXPECT_GE(fault.at("count").get<long long>(), 1);
+  // The time of the cycle (a recording's t) and what the fault means.
+  EXPECT_DOUBLE_EQ(fault.at("first_s").get<double>(),
+                   static_cast<double>(fault.at("first_cycle").get<long long>()) / kRate);
+  EXPECT_EQ(fault.at("cause"), "the driver reported an error, bad data or a device fault");
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "selfsense/identification/fit_quality.hpp"
@@ -514,6 +515,32 @@ TEST(Loop, AStallCountsEveryDeadlineItMissed) {
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kFaulted);
   EXPECT_NE(b.loop->supervisor().latched() & bit(Fault::kOverrun), 0U);
   EXPECT_EQ(b.loop->local_status().last.command, 0.0);
+}
+
+// within_count 0 leaves only the stall criterion (config/sim.yaml on a shared machine): long
+// runs of late cycles do not fault, a stall of `consecutive` missed deadlines still does.
+TEST(Loop, WithinCountZeroFaultsOnlyOnAStall) {
+  LoopConfig lc;
+  lc.overrun = {2000, 0, 64};
+  std::string why;
+  ASSERT_TRUE(lc.overrun.is_valid(&why)) << why;
+  Bench b(test::daemon_plant(kRate), bench_control(), lc);
+  start(b, ControlMode::kPosition);
+  for (int k = 0; k < 500; ++k) {
+    b.loop->cycle(true);  // late, one overrun each
+    b.loop->cycle(false);
+  }
+  for (int k = 0; k < 900; ++k)
+    b.loop->cycle(true);  // 900 late cycles in a row
+  b.loop->cycle(false);
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+  b.loop->cycle(true, 1998);  // 1999 in a row
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
+  b.loop->cycle(true);  // 2000 in a row
+  EXPECT_EQ(b.loop->supervisor().state(), LoopState::kFaulted);
+  EXPECT_NE(b.loop->supervisor().latched() & bit(Fault::kOverrun), 0U);
+  EXPECT_FALSE((OverrunPolicy{2000, 65, 100}.is_valid(&why)));
+  EXPECT_EQ(why, "safety.overrun.within_count: must be in [0, 64]");
 }
 
 // A wave that ended or was stopped after playing longer than the watchdog used to fault in the

@@ -10,8 +10,9 @@
 // reporting, before writing).
 //
 // Overrun policy: a fault after `consecutive` overruns in a row, or `within_count` overruns
-// within the last `window` cycles. A stall counts every deadline it missed: one late cycle after
-// k missed periods is k + 1 overruns in a row (the amplifier held its command that long).
+// within the last `window` cycles (within_count 0: no such criterion, only `consecutive`). A
+// stall counts every deadline it missed: one late cycle after k missed periods is k + 1 overruns
+// in a row (the amplifier held its command that long).
 // Real-time safe: every method is noexcept, allocation-free.
 #pragma once
 
@@ -42,13 +43,15 @@ enum class Fault : std::uint8_t {
 inline constexpr std::size_t kFaultCount = static_cast<std::size_t>(Fault::kCount);
 
 [[nodiscard]] std::string_view to_string(Fault f) noexcept;
+// What a fault means, in a few words (status `fault_details.*.cause`).
+[[nodiscard]] std::string_view cause_of(Fault f) noexcept;
 [[nodiscard]] constexpr std::uint32_t bit(Fault f) noexcept {
   return 1U << static_cast<unsigned>(f);
 }
 
 struct OverrunPolicy {
   std::uint32_t consecutive{3};    // >= 1
-  std::uint32_t within_count{10};  // >= 1
+  std::uint32_t within_count{10};  // 0 (off) .. 64
   std::uint32_t window{10000};     // cycles, >= within_count
   [[nodiscard]] bool is_valid(std::string* why) const;
   friend bool operator==(const OverrunPolicy&, const OverrunPolicy&) = default;

@@ -26,8 +26,10 @@ cp "$files/config/plant/daemon.yaml" /etc/selfsense/plant/
 # tolerated, also as faults, so that the loop can be armed (this test is about systemd, not timing).
 sed -e 's/rate_hz: 10000/rate_hz: 1000/' -e 's/frequency_hz: 2000.0/frequency_hz: 300.0/' \
   -e 's/allow_degraded_timing: false/allow_degraded_timing: true/' \
-  -e 's/^safety:$/safety:\n  overrun: {consecutive: 1000000, within_count: 64, window_cycles: 64}/' \
+  -e 's/^  overrun: {consecutive: 3, within_count: 10, window_cycles: 10000}$/  overrun: {consecutive: 1000000, within_count: 0}/' \
   "$files/config/selfsensed.yaml" >/etc/selfsense/selfsensed.yaml
+grep -q '^  overrun: {consecutive: 1000000' /etc/selfsense/selfsensed.yaml ||
+  fail "config/selfsensed.yaml's overrun policy changed: this test's tolerance was not put in"
 selfsense check-config /etc/selfsense/selfsensed.yaml || fail "check-config rejected the configuration"
 
 install -m 0755 /payload/bin/selfsensed /usr/local/bin/selfsensed
