@@ -1,0 +1,81 @@
+// The candidates of a diagnosis: each effect of physics.md a channel correction can add, as a
+// unit that carries its terms (identification/correction_fit.hpp), the channels it applies to,
+// the signals it needs, its parameter count (complexity of its terms) and its own description of
+// what it found. Adding an effect is one entry of candidates() (candidates.cpp) and its test.
+// Pure math.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "channel_data.hpp"
+#include "selfsense/diagnosis/diagnosis.hpp"
+#include "selfsense/identification/correction_fit.hpp"
+
+namespace selfsense::diagnosis::detail {
+
+using identification::CorrectionTerm;
+using models::ChannelCorrection;
+
+enum class Needs : std::uint8_t { kNothing, kTemperature, kStress, kSensed, kChargeDrive };
+
+// What a description reads: the fitted correction, the channel, the recording, the output before
+// the correction, and the common tail (how much it explains, how it was judged).
+struct Evidence {
+  const ChannelCorrection& c;
+  const ChannelData& ch;
+  const Signals& s;
+  const std::vector<double>& before;
+  double range;  // of the recorded channel
+  double pct;    // 100 / range
+  std::string tail;
+};
+using Describe = void (*)(Finding&, const Evidence&);
+
+struct Candidate {
+  const char* effect;  // physics.md word
+  std::vector<CorrectionTerm> terms;
+  bool on_sensed;  // the reconstruction can invert it on the sensed channel
+  bool on_strain;
+  Needs needs;
+  Describe describe;  // fills the finding's evidence and its explaining feature
+  // The hysteresis operators bend to many residuals (a static curve, a slow drift under a
+  // periodic drive): chosen only when no specific physics explains the residual significantly.
+  bool generic{false};
+};
+
+[[nodiscard]] const std::vector<Candidate>& candidates();
+
+[[nodiscard]] bool uses_term(const Candidate& c, CorrectionTerm t);
+[[nodiscard]] bool is_creep(const Candidate& c);
+
+// The candidate applies to this channel with these signals.
+[[nodiscard]] bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s,
+                              bool has_sensed, bool charge_drive);
+
+// Creep keeps moving in the direction of the last step (candidates.cpp).
+[[nodiscard]] bool creep_moves_with_the_step(const ChannelCorrection& c);
+
+// An effect is named once per channel, in whichever of its forms fitted first.
+[[nodiscard]] bool named_already(const std::vector<const Candidate*>& used, const Candidate& c);
+
+// The candidate brings a filter whose parameters are not chosen yet.
+[[nodiscard]] bool searches_filter(const Candidate& c, const ChannelCorrection& accepted);
+
+// Coefficients and searched parameters of a set of terms: the parsimony tie-break.
+[[nodiscard]] std::size_t complexity(const std::vector<CorrectionTerm>& terms);
+
+// a, then the terms of b not in a.
+[[nodiscard]] std::vector<CorrectionTerm> merged(const std::vector<CorrectionTerm>& a,
+                                                 const std::vector<CorrectionTerm>& b);
+
+// The finding's evidence and feature, in the candidate's own words; `judged` says how it was
+// judged ("on held-out blocks ...").
+void describe(Finding& f, const Candidate& candidate, const ChannelCorrection& c,
+              const ChannelData& ch, const Signals& s, const std::vector<double>& before,
+              const std::vector<double>& after, const std::string& judged);
+
+}  // namespace selfsense::diagnosis::detail

@@ -1,0 +1,245 @@
+#include "search.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string_view>
+
+#include "text.hpp"
+
+namespace selfsense::diagnosis::detail {
+
+void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>& findings) {
+  for (std::size_t round = 0; round < in.options.max_effects && st.current_sse > 0.0; ++round) {
+    struct Tried {
+      const Candidate* candidate;
+      identification::CorrectionFit fit;
+      double explains;
+      BlockShares blocks;  // over the held-out blocks
+      HoldJudgement holds;
+      std::vector<CorrectionTerm> terms;
+      ChannelCorrection start;
+      bool levels_judged;  // on held-out holds (hysteresis operators, when needed)
+      bool in_pool{false};
+    };
+    std::vector<Tried> tried;
+    for (const Candidate& c : candidates()) {
+      if (named_already(st.used, c)) continue;
+      if (!applicable(c, in.ch, in.s, in.has_sensor, in.charge_drive)) continue;
+      const std::vector<CorrectionTerm> terms = merged(st.accepted_terms, c.terms);
+      ChannelCorrection start = st.accepted;
+      try {
+        if (searches_filter(c, st.accepted) && !st.accepted_terms.empty()) {
+          // Search the new filter's parameters on what the st.accepted terms leave (few columns),
+          // then refit every coefficient jointly with the filters fixed.
+          identification::CorrectionSignals on_current = in.cs;
+          on_current.y = st.current;
+          const ChannelCorrection found =
+              identification::fit_correction(on_current, c.terms, ChannelCorrection{}, in.rows.fit)
+                  .correction;
+          start.leakage_tau_s = std::max(start.leakage_tau_s, found.leakage_tau_s);
+          start.delay_s = std::max(start.delay_s, found.delay_s);
+          if (start.dynamics_frequency_hz == 0.0) {
+            start.dynamics_frequency_hz = found.dynamics_frequency_hz;
+            start.dynamics_damping = found.dynamics_damping;
+          }
+        }
+        identification::CorrectionFit fit =
+            identification::fit_correction(in.cs, terms, start, in.rows.fit);
+        // A correction that must rescale the model's own output by more than 100 % is a
+        // different model, not physics the model left out (re-identify instead).
+        if (std::abs(fit.correction.gain) > in.options.max_gain) continue;
+        if (is_creep(c) && !creep_moves_with_the_step(fit.correction)) continue;
+        const double sse = sse_over(in.ch.recorded, fit.output, in.rows.judge);
+        const double explains = 1.0 - sse / st.current_sse;
+        const BlockShares shares = block_explains(in.ch.recorded, st.current, fit.output, in.rows);
+        HoldJudgement holds;
+        if (is_creep(c) && explains >= in.options.min_explains &&
+            !passes_blocks(shares, in.options)) {
+          holds = judge_on_holds(in.cs, terms, start, in.rows, st.current, in.holds,
+                                 HoldMeasure::kMovement, in.options);
+        }
+        tried.push_back({&c, std::move(fit), explains, shares, holds, terms, start, false});
+      } catch (const std::invalid_argument&) {
+        continue;  // no finite fit of this candidate on these signals: not a candidate here
+      }
+    }
+    if (tried.empty()) break;
+    std::sort(tried.begin(), tried.end(),
+              [](const Tried& a, const Tried& b) { return a.explains > b.explains; });
+    // The held-out holds judge a hysteresis operator only when it would be named or listed
+    // (each judgement costs a fit).
+    const auto significant = [&](Tried& t) {
+      if (t.explains < in.options.min_explains ||
+          t.explains * st.current_sse < in.options.min_share * st.original_sse) {
+        return false;
+      }
+      const bool in_blocks = passes_blocks(t.blocks, in.options);
+      if (!t.candidate->generic) return in_blocks || creep_passes_on_holds(t.holds, in.options);
+      if (!in_blocks) return false;
+      if (!t.levels_judged) {
+        t.levels_judged = true;
+        t.holds = judge_on_holds(in.cs, t.terms, t.start, in.rows, st.current, in.holds,
+                                 HoldMeasure::kLevel, in.options);
+      }
+      return harmless_on_holds(t.holds, in.options);
+    };
+    // Specific physics first: when one is significant, a generic candidate competes only if
+    // it leaves clearly less (a loop the specific terms merely resemble); otherwise it is an
+    // alternative and may explain what is left in a later round.
+    double specific_left = std::numeric_limits<double>::infinity();
+    for (Tried& t : tried) {
+      if (!t.candidate->generic && significant(t)) {
+        specific_left = std::min(specific_left, 1.0 - t.explains);
+      }
+    }
+    const auto competes = [&](const Tried& t) {
+      return !t.candidate->generic || 1.0 - t.explains <= in.options.generic_ratio * specific_left;
+    };
+    // The pool: candidates that compete and are significant, best first (a generic candidate
+    // that fails on the held-out holds leaves the others their chance).
+    for (Tried& t : tried)
+      t.in_pool = competes(t) && significant(t);
+    const auto pool =
+        static_cast<std::size_t>(std::stable_partition(tried.begin(), tried.end(),
+                                                       [](const Tried& t) { return t.in_pool; }) -
+                                 tried.begin());
+    if (pool == 0) break;
+    // Of the candidates explaining about as much as the best, the simplest.
+    std::size_t chosen = 0;
+    for (std::size_t i = 1; i < pool; ++i) {
+      if (1.0 - tried[i].explains <= in.options.parsimony_ratio * (1.0 - tried.front().explains) &&
+          complexity(tried[i].candidate->terms) < complexity(tried[chosen].candidate->terms)) {
+        chosen = i;
+      }
+    }
+    std::swap(tried[0], tried[chosen]);
+    Tried& best = tried.front();
+
+    Finding f;
+    f.effect = best.candidate->effect;
+    f.channel = in.ch.name;
+    // Contract: the share of the channel's residual variance (held-out blocks) this physics
+    // removes, so the shares of several findings add up.
+    f.explains = st.original_sse > 0.0 ? best.explains * st.current_sse / st.original_sse : 0.0;
+    for (std::size_t i = 1; i < tried.size(); ++i) {
+      // Another form of the same effect is not an alternative (the finding names it anyway).
+      if (tried[i].explains >= in.options.alternative_share * best.explains &&
+          std::string_view(tried[i].candidate->effect) != std::string_view(f.effect) &&
+          significant(tried[i])) {
+        Finding other;
+        other.effect = tried[i].candidate->effect;
+        other.explains =
+            st.original_sse > 0.0 ? tried[i].explains * st.current_sse / st.original_sse : 0.0;
+        describe(other, *tried[i].candidate, tried[i].fit.correction, in.ch, in.s, st.current,
+                 tried[i].fit.output, judged_on(tried[i].holds, in.options));
+        f.alternatives.push_back({other.effect, other.explains, std::move(other.evidence)});
+      }
+    }
+    const std::size_t n = st.current.size();
+    std::vector<double> change(n);
+    for (std::size_t k = 0; k < n; ++k)
+      change[k] = best.fit.output[k] - st.current[k];
+    f.where = large_segments(change, 1.5, 5);
+    if (f.where.empty()) f.where = {{0, n}};  // spread evenly: the whole record
+    const std::string judged = judged_on(best.holds, in.options);
+    describe(f, *best.candidate, best.fit.correction, in.ch, in.s, st.current, best.fit.output,
+             judged);
+    findings.push_back(std::move(f));
+
+    st.accepted_terms = merged(st.accepted_terms, best.candidate->terms);
+    st.accepted = best.fit.correction;
+    st.used.push_back(best.candidate);
+    st.current = best.fit.output;
+    st.current_sse = sse_over(in.ch.recorded, st.current, in.rows.judge);
+  }
+}
+
+void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& findings) {
+  constexpr double kLocalEvidence = 20.0;
+  const std::size_t n = st.current.size();
+  std::vector<double> residual(n);
+  for (std::size_t k = 0; k < n; ++k)
+    residual[k] = in.ch.recorded[k] - st.current[k];
+  for (const Segment& seg : large_segments(residual, 3.0, 3)) {
+    const bool known = std::any_of(findings.begin(), findings.end(), [&](const Finding& f) {
+      return f.channel == in.ch.name &&
+             std::any_of(f.where.begin(), f.where.end(),
+                         [&](const Segment& w) { return overlaps(w, seg); });
+    });
+    const auto seg_n = static_cast<double>(seg.end - seg.begin);
+    const double before = segment_sse(in.ch.recorded, st.current, seg);
+    if (known || seg_n < 16.0 || !(before > 0.0)) continue;
+    std::vector<bool> in_segment(n, false);
+    for (std::size_t k = seg.begin; k < seg.end; ++k) {
+      in_segment[k] = in.rows.fit[k] || in.rows.judge[k];
+    }
+    identification::CorrectionSignals on_current = in.cs;
+    on_current.y = st.current;
+    const Candidate* best = nullptr;
+    ChannelCorrection best_found;
+    double best_bic = -kLocalEvidence;
+    for (const Candidate& c : candidates()) {
+      if (named_already(st.used, c)) continue;
+      if (!applicable(c, in.ch, in.s, in.has_sensor, in.charge_drive)) continue;
+      // A hysteresis operator fitted to one stretch would bend to anything in it: transients
+      // are named by specific physics only.
+      if (c.generic) continue;
+      identification::CorrectionFit local;
+      try {
+        local =
+            identification::fit_correction(on_current, c.terms, ChannelCorrection{}, in_segment);
+      } catch (const std::invalid_argument&) {
+        continue;  // no finite fit in this stretch
+      }
+      if (is_creep(c) && !creep_moves_with_the_step(local.correction)) continue;
+      const double after = segment_sse(in.ch.recorded, local.output, seg);
+      const double bic = seg_n * std::log(std::max(after, 1e-300) / before) +
+                         static_cast<double>(complexity(c.terms)) * std::log(seg_n);
+      if (after <= 0.5 * before && bic < best_bic) {
+        best_bic = bic;
+        best = &c;
+        best_found = local.correction;
+      }
+    }
+    if (best == nullptr) continue;
+    ChannelCorrection start = st.accepted;
+    start.leakage_tau_s = std::max(start.leakage_tau_s, best_found.leakage_tau_s);
+    start.delay_s = std::max(start.delay_s, best_found.delay_s);
+    if (start.dynamics_frequency_hz == 0.0) {
+      start.dynamics_frequency_hz = best_found.dynamics_frequency_hz;
+      start.dynamics_damping = best_found.dynamics_damping;
+    }
+    const std::vector<CorrectionTerm> terms = merged(st.accepted_terms, best->terms);
+    identification::CorrectionFit joint;
+    try {
+      joint = identification::fit_correction(in.cs, terms, start, in.rows.fit);
+    } catch (const std::invalid_argument&) {
+      continue;
+    }
+    const double held_before = sse_over(in.ch.recorded, st.current, in.rows.judge);
+    const double held_after = sse_over(in.ch.recorded, joint.output, in.rows.judge);
+    const double seg_after = segment_sse(in.ch.recorded, joint.output, seg);
+    if (held_after > 1.02 * held_before || seg_after > 0.5 * before) continue;
+    Finding f;
+    f.effect = best->effect;
+    f.channel = in.ch.name;
+    // Contract: the share of the channel's residual variance (held-out blocks) it removes; the
+    // share within its stretch goes into the evidence.
+    f.explains =
+        st.original_sse > 0.0 ? std::max(0.0, held_before - held_after) / st.original_sse : 0.0;
+    f.where = {seg};
+    const std::string judged =
+        format("in the one stretch of %.3g s that shows it (%.0f %% there; BIC %.3g)",
+               seg_n * in.s.sample_time, 100.0 * (1.0 - seg_after / before), best_bic);
+    describe(f, *best, joint.correction, in.ch, in.s, st.current, joint.output, judged);
+    findings.push_back(std::move(f));
+    st.used.push_back(best);
+    st.accepted_terms = terms;
+    st.accepted = joint.correction;
+    st.current = joint.output;
+  }
+}
+
+}  // namespace selfsense::diagnosis::detail

@@ -1,0 +1,47 @@
+// The search for the physics a channel's model leaves out (docs/diagnose.md, "How"): rounds of
+// every candidate fitted on the fitting blocks and judged on the held-out ones (held_out.hpp),
+// the best significant one accepted and refitted jointly with those accepted before; then a
+// local pass for transients. Pure math.
+#pragma once
+
+#include <vector>
+
+#include "candidates.hpp"
+#include "held_out.hpp"
+
+namespace selfsense::diagnosis::detail {
+
+// What the search reads: the channel, its correction signals, the recording, the rows, the
+// drive's holds.
+struct SearchInput {
+  const ChannelData& ch;
+  const identification::CorrectionSignals& cs;
+  const Signals& s;
+  const Rows& rows;
+  const std::vector<Segment>& holds;
+  bool has_sensor;
+  bool charge_drive;
+  const Options& options;
+};
+
+// The search's state on one channel: what has been accepted so far.
+struct SearchState {
+  std::vector<CorrectionTerm> accepted_terms{};
+  ChannelCorrection accepted{};
+  std::vector<double> current{};  // the output with the accepted corrections
+  std::vector<const Candidate*> used{};
+  double current_sse{0.0};   // on the held-out blocks
+  double original_sse{0.0};  // of the model's own output there
+};
+
+// Rounds of candidates until none is significant (or options.max_effects): findings appended.
+void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>& findings);
+
+// Transients the block statistics cannot see (ringing after one fast step is a few samples of a
+// long record): each strong residual segment not already explained is fitted on its own samples;
+// a candidate is named when it removes most of the segment's residual with strong evidence for
+// its extra parameters (BIC: n ln(SSE1/SSE0) + p ln n < -kLocalEvidence), and, refitted with
+// the accepted terms on the fitting blocks, does not make the held-out blocks worse.
+void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& findings);
+
+}  // namespace selfsense::diagnosis::detail
