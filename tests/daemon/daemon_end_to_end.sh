@@ -20,9 +20,12 @@ if [ -s "$out/faults.txt" ]; then
 fi
 [ "$(grep -c 'selfsensed exited with status 0' "$out/main_job.out")" = 2 ] ||
   fail "a selfsensed did not exit 0 on SIGTERM: $(grep 'exited with status' "$out/main_job.out")"
-# Figures (measured: S_hat 0.19 %, true S 0.22 %; T_hat 0.34 %, true T 0.98-1.04 %): the loop holds
-# the self-sensed signal on the setpoint; the true one is off by the model's error. The true
-# figures are asserted at the daemon issue's goals (0.5 % and 2 %).
+# Figures: the loop holds the self-sensed signal on the setpoint; the true one is off by the
+# model's error. Measured in ten runs (2026-11-26): S_hat 0.178-0.186 %, true S 0.210-0.219 %;
+# T_hat 0.335-0.340 %, true T 0.966-1.119 %. The simulated plant advances one cycle per read, so
+# only the setpoints' timing on the real clock varies from run to run (spread 4 % on S, 16 % on
+# true T); each figure is asserted at about 1.3x the largest seen, under the daemon issue's goals
+# (0.5 % and 2 %).
 check() {  # check SEGMENT COLUMN LIMIT_PERCENT
   local v
   v=$(sed -n "s/^$1: .* $2 \([0-9.]*\) % RMS.*/\1/p" "$out/figures.txt")
@@ -30,18 +33,24 @@ check() {  # check SEGMENT COLUMN LIMIT_PERCENT
   awk -v v="$v" -v lim="$3" 'BEGIN { exit !(v < lim) }' || fail "$1 $2 $v % >= $3 %"
   echo "ok: $1 $2 $v % < $3 %"
 }
-check position S_hat 0.5
-check position S 0.5
-check force T_hat 0.8
-check force T 2
+check position S_hat 0.25
+check position S 0.29
+check force T_hat 0.44
+check force T 1.45
 # The damping run (config/damping-sim.yaml, a 300 Hz mount with 1 % damping, `ctl impulse`):
-# measured 156.8 ms -> 9.9-11.0 ms on true S, 14.3-15.8x; the issue's goal is 10x.
+# measured 156.8-158.4 ms -> 9.9-11.1 ms on true S, 14.3-15.8x (14.3x in all ten runs of
+# 2026-11-26); the issue's goal is 10x. Asserted: the ratio > 11x and the undamped ring-down
+# > 120 ms (1.3x under the lowest seen), the damped one > 0 (a ring-down, not an impulse that
+# never arrived).
 ratio=$(sed -n 's/^damping: ring-down shortened \([0-9.]*\)x on true S.*/\1/p' "$out/figures.txt")
 [ -n "$ratio" ] || fail "no damping figure in: $(cat "$out/figures.txt")"
 awk -v r="$ratio" 'BEGIN { exit !(r > 11) }' || fail "damping shortened the ring-down only ${ratio}x"
 echo "ok: damping ${ratio}x > 11x"
 undamped=$(sed -n 's/^undamped: .* true S \([0-9.]*\) ms.*/\1/p' "$out/figures.txt")
-awk -v v="$undamped" 'BEGIN { exit !(v > 100) }' || fail "the undamped mount rang only $undamped ms"
+awk -v v="$undamped" 'BEGIN { exit !(v > 120) }' || fail "the undamped mount rang only $undamped ms"
+damped=$(sed -n 's/^damped: .* true S \([0-9.]*\) ms.*/\1/p' "$out/figures.txt")
+awk -v v="$damped" 'BEGIN { exit !(v > 0) }' || fail "no damped ring-down: '$damped' ms"
+echo "ok: ring-down of true S ${undamped} ms > 120 ms undamped, ${damped} ms > 0 damped"
 
 # The recordings are contract CSV: the tool reads them (reconstruct from E and D).
 for segment in position force undamped damped; do

@@ -105,9 +105,10 @@ TEST(StressHysteresis, ReconstructsStressWhereTheAffineModelCannot) {
   std::printf("held out: T_hat %.3f %% (affine model %.2f %%), S_hat %.3f %%\n", 100 * q_vec.nrmse,
               100 * q_aff.nrmse, 100 * q_s.nrmse);
   // Measured: T_hat 0.735 % (affine model 9.01 %), S_hat 0.395 % of range, held out; the bounds
-  // are about 1.2x (docs/results.md).
+  // are about 1.2x, the affine model's 1.3x (docs/results.md).
   EXPECT_LT(q_vec.nrmse, 0.009);
   EXPECT_LT(q_vec.nrmse, 0.2 * q_aff.nrmse);
+  EXPECT_LT(q_aff.nrmse, 0.117);
   EXPECT_LT(q_s.nrmse, 0.0047);
   EXPECT_EQ(vectorial.status_counts()[SampleStatus::kOk], r.e.size());
 }

@@ -167,10 +167,11 @@ TEST(Loop, PositionTracksAStaircaseAndASineOnTheSelfSensedStrain) {
   const Tracking t = track(b, sp, scored, false);
   std::printf("position: true S %.3f %% of range RMS, S_hat %.3f %%\n", 100 * t.truth_nrmse,
               100 * t.hat_nrmse);
-  // The loop holds S_hat on the setpoint (measured 0.26 %); the true S is off by that and the
+  // The loop holds S_hat on the setpoint (measured 0.263 %); the true S is off by that and the
   // model's error under the load spring (measured 0.285 %; the daemon issue's goal is 0.5 %).
-  EXPECT_LT(t.hat_nrmse, 0.004);
-  EXPECT_LT(t.truth_nrmse, 0.004);
+  // Deterministic (simulated time): bounded at about 1.3x of the measured figures.
+  EXPECT_LT(t.hat_nrmse, 0.0034);
+  EXPECT_LT(t.truth_nrmse, 0.0037);
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
 }
 
@@ -249,10 +250,10 @@ TEST(Loop, ForceTracksStepsOnTheSelfSensedStress) {
   const Tracking t = force_steps(b);
   std::printf("force: true T %.3f %% of range RMS, T_hat %.3f %%\n", 100 * t.truth_nrmse,
               100 * t.hat_nrmse);
-  // T_hat on the setpoint (measured 0.34 %); the true T off by that and the model's stress
-  // error (measured 0.46 %; the daemon issue's goal is 2 %).
-  EXPECT_LT(t.hat_nrmse, 0.008);
-  EXPECT_LT(t.truth_nrmse, 0.0075);
+  // T_hat on the setpoint (measured 0.340 %); the true T off by that and the model's stress
+  // error (measured 0.462 %; the daemon issue's goal is 2 %). Bounds about 1.3x of those.
+  EXPECT_LT(t.hat_nrmse, 0.0044);
+  EXPECT_LT(t.truth_nrmse, 0.006);
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
 }
 
@@ -271,9 +272,9 @@ TEST(Loop, ForceTracksStepsAfterAPositionRun) {
   const Tracking t = force_steps(b);
   std::printf("force after position: true T %.3f %% of range RMS, T_hat %.3f %%\n",
               100 * t.truth_nrmse, 100 * t.hat_nrmse);
-  // Measured 0.77 % (T_hat 0.34 %).
-  EXPECT_LT(t.hat_nrmse, 0.008);
-  EXPECT_LT(t.truth_nrmse, 0.012);
+  // Measured 0.772 % (T_hat 0.339 %); bounds about 1.3x of those.
+  EXPECT_LT(t.hat_nrmse, 0.0044);
+  EXPECT_LT(t.truth_nrmse, 0.01);
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
 }
 
@@ -314,8 +315,11 @@ TEST(Loop, DampingShortensTheRingDownTenfold) {
   const double damped = ring_down_s(ControlMode::kDamping);
   std::printf("ring-down to 5 %%: open loop %.4f s, damping %.4f s (%.1fx)\n", open, damped,
               open / damped);
-  EXPECT_GT(open, 0.1);            // the undamped mode rings (measured 0.16 s)
-  EXPECT_GT(open / damped, 10.0);  // the goal; measured 15.4x
+  // Measured 0.159 s and 0.0103 s (15.4x; the goal is 10x): bounded at about 1.3x.
+  EXPECT_GT(open, 0.12);  // the undamped mode rings
+  EXPECT_LT(open, 0.21);
+  EXPECT_GT(damped, 0.0);  // the damped mode rings too: a ring-down, not an impulse never seen
+  EXPECT_GT(open / damped, 11.8);
 }
 
 // The paper's comparison (20x with a constant permittivity, 60x with eps(E)): the same damping
@@ -338,11 +342,16 @@ TEST(Loop, DampingWithAConstantPermittivityAgainstEpsOfE) {
       "ring-down shortened: constant permittivity %.1fx, eps(E) %.1fx, hysteresis-creep "
       "%.1fx\n",
       open / with_linear, open / with_eps, open / with_full);
-  // Measured 12.0x, 8.1x and 14.6x. Not the paper's order: its eps(E) is the static curve, and
-  // around an operating point of a hysteretic stack the small ring follows the minor-loop slope,
-  // which the hysteresis model tracks after every reversal and the static curve does not.
-  EXPECT_GT(open / with_linear, 9.0);
-  EXPECT_GT(open / with_eps, 6.0);
+  // Measured 12.0x, 8.1x and 14.6x (bounded at about 1.3x below). Not the paper's order: its
+  // eps(E) is the static curve, and around an operating point of a hysteretic stack the small
+  // ring follows the minor-loop slope, which the hysteresis model tracks after every reversal
+  // and the static curve does not.
+  EXPECT_GT(with_linear, 0.0);
+  EXPECT_GT(with_eps, 0.0);
+  EXPECT_GT(with_full, 0.0);
+  EXPECT_GT(open / with_linear, 9.2);
+  EXPECT_GT(open / with_eps, 6.2);
+  EXPECT_GT(open / with_full, 11.2);
   EXPECT_GT(with_linear, 1.1 * with_full);
   EXPECT_GT(with_eps, 1.1 * with_full);
 }

@@ -71,8 +71,12 @@ check() {  # check COLUMN LIMIT_PERCENT
   awk -v v="$v" -v lim="$2" 'BEGIN { exit !(v < lim) }' || fail "position $1 $v % >= $2 %"
   echo "ok: position over Modbus TCP: $1 $v % RMS < $2 %"
 }
-check S_hat 1.0
-check S 2.0
+# Measured in twelve runs (2026-11-26): S_hat 0.047-0.049 %, asserted at about 1.3x of that.
+# True S 0.036-0.278 % (ten of them 0.043-0.083 %): the device's plant runs on its own clock in
+# another process and its spread is wide, so the figure is measured-only and asserted at the
+# daemon issue's goal (0.5 %), 1.8x the largest seen.
+check S_hat 0.065
+check S 0.5
 # A clean run: no exception responses and no bad frames (a timeout or two may happen on a loaded
 # machine; they are counted, and the figures above hold).
 [ "$(counter driver_device_faults)" = 0 ] || fail "exception responses in a clean run: $(ctl status)"

@@ -118,9 +118,9 @@ TEST(SpiLoop, PositionTracksAStaircaseOverTheEmulatedAdcAndDac) {
   std::printf("spi position: S_hat %.3f %% of range RMS, true S %.3f %%\n", 100 * hat, 100 * truth);
   // Measured 0.053 % and 0.074 % (a staircase; the loop tests' staircase and sine on the
   // simulated driver 0.26 % and 0.285 %): the frames, codes and the DAC's 16-bit quantisation
-  // add little.
-  EXPECT_LT(hat, 0.005);
-  EXPECT_LT(truth, 0.0012);
+  // add little. Simulated time, so deterministic: bounded at about 1.3x of the measured figures.
+  EXPECT_LT(hat, 0.0007);
+  EXPECT_LT(truth, 0.00096);
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kArmed);
   const runtime::DriverCounters c = b.spi->driver.counters();
   EXPECT_EQ(c.bad_data + c.stale + c.timeouts + c.errors, 0U);
