@@ -388,14 +388,19 @@ void refine(const CorrectionSignals& s, std::span<const CorrectionTerm> terms,
   }
 }
 
-std::vector<double> filtered(std::span<const double> x, const ChannelCorrection& filters,
-                             double ts) {
-  CorrectionStage stage(filters, ts);
-  std::vector<double> out(x.size());
-  for (std::size_t k = 0; k < x.size(); ++k) {
-    out[k] = stage.step({x[k], 0.0, 0.0, filters.temperature_reference_degc, 0.0, 0.0});
-  }
-  return out;
+// The filters of a correction over a signal, into `out` (sized like x; reused between grid
+// points, so a search allocates its columns once).
+void filter_into(std::span<const double> x, const ChannelCorrection& filters, double ts,
+                 std::vector<double>& out) {
+  ChannelCorrection only;  // the filters without any term (a column is filtered, not corrected)
+  only.dynamics_frequency_hz = filters.dynamics_frequency_hz;
+  only.dynamics_damping = filters.dynamics_damping;
+  only.leakage_tau_s = filters.leakage_tau_s;
+  only.delay_s = filters.delay_s;
+  CorrectionStage stage(only, ts);
+  out.resize(x.size());
+  for (std::size_t k = 0; k < x.size(); ++k)
+    out[k] = stage.filter(x[k]);
 }
 
 struct Solved {
@@ -485,31 +490,40 @@ struct Regressors {
   std::vector<double> target{};
 };
 
-Regressors regressors(const CorrectionSignals& s, const Columns& columns,
-                      const ChannelCorrection& filters) {
+// Fills `r` for these filters, reusing its buffers (a filter search evaluates many settings).
+void fill_regressors(const CorrectionSignals& s, const Columns& columns,
+                     const ChannelCorrection& filters, Regressors& r) {
   // Unfiltered columns are read in place (a 1e6-sample recording: no copies per evaluation).
   const bool any_filter = !filters.empty();
   const std::size_t n = s.y.size();
-  Regressors r;
+  r.columns.clear();
   r.columns.reserve(columns.phi.size());
-  if (any_filter) r.owned.reserve(columns.phi.size());
-  for (const std::vector<double>& phi : columns.phi) {
-    if (any_filter) {
-      r.owned.push_back(filtered(phi, filters, s.sample_time));
-      r.columns.emplace_back(r.owned.back());
-    } else {
-      r.columns.emplace_back(phi);
+  if (any_filter) {
+    r.owned.resize(columns.phi.size() + 1);  // the last one: F[y]
+    for (std::size_t i = 0; i < columns.phi.size(); ++i) {
+      filter_into(columns.phi[i], filters, s.sample_time, r.owned[i]);
+      r.columns.emplace_back(r.owned[i]);
     }
+  } else {
+    for (const std::vector<double>& phi : columns.phi)
+      r.columns.emplace_back(phi);
   }
   r.target.assign(s.recorded.begin(), s.recorded.end());
   if (any_filter) {
-    const std::vector<double> fy = filtered(s.y, filters, s.sample_time);
+    std::vector<double>& fy = r.owned.back();
+    filter_into(s.y, filters, s.sample_time, fy);
     for (std::size_t k = 0; k < n; ++k)
       r.target[k] -= fy[k];
   } else {
     for (std::size_t k = 0; k < n; ++k)
       r.target[k] -= s.y[k];
   }
+}
+
+Regressors regressors(const CorrectionSignals& s, const Columns& columns,
+                      const ChannelCorrection& filters) {
+  Regressors r;
+  fill_regressors(s, columns, filters, r);
   return r;
 }
 
@@ -566,9 +580,10 @@ CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const Correct
   const Columns columns = make_columns(s, terms);
   Solved best;
   ChannelCorrection best_filters;
+  Regressors work;  // the columns of each setting tried, in buffers allocated once
   const auto evaluate = [&](const ChannelCorrection& filters) {
-    const Regressors r = regressors(s, columns, filters);
-    Solved solved = solve(r.target, r.columns, fit_rows);
+    fill_regressors(s, columns, filters, work);
+    Solved solved = solve(work.target, work.columns, fit_rows);
     if (solved.sse < best.sse) {
       best = std::move(solved);
       best_filters = filters;

@@ -325,6 +325,17 @@ double CorrectionStage::step(const Inputs& in) noexcept {
   return filters(v);
 }
 
+double CorrectionStage::filter(double v) noexcept {
+  if (!started_) {  // the filters start at the first value, as in step()
+    started_ = true;
+    v1_ = v2_ = w1_ = w2_ = v;
+    m_ = w_prev_ = v;
+    line_.fill(v);
+    return v;
+  }
+  return filters(v);
+}
+
 double CorrectionStage::delay_drive(double drive) noexcept {
   if (!drive_started_) {
     drive_started_ = true;

@@ -4,20 +4,23 @@
 //
 // For each output channel the model has and the recording references (D, S):
 //   1. residual e = recorded - model; correlation tests and large segments (residual_tests.hpp)
-//   2. every candidate effect of physics.md that the channel can show is fitted as a
-//      correction (models/channel_correction.hpp, identification/correction_fit.hpp) on the
-//      fitting blocks only (alternate tenths of the record), and judged on the other blocks:
-//      explains = 1 - SSE_after / SSE_before there
-//   3. the best candidate is accepted when it explains at least `min_explains` of the held-out
-//      residual, overall and in the median held-out block (a term that fits one stretch by
-//      chance is not named); creep, which lives in the holds after steps, may instead pass on
-//      held-out holds (each hold refitted without it: the movement within the holds explained,
-//      in two or more), and a hysteresis operator, which can draw any level, must also leave the
-//      held-out holds no worse; of candidates explaining about as much, the simplest wins;
-//      candidates that pass too and explain nearly as much are reported as alternatives, with
-//      their own evidence; then the search repeats on what is left (several effects in turn),
-//      refitting the accepted terms jointly with each new candidate
+//   2. every candidate effect of physics.md that the channel can show (src/diagnosis/
+//      candidates.cpp) is fitted as a correction (models/channel_correction.hpp,
+//      identification/correction_fit.hpp) on the fitting blocks only (alternate twentieths of
+//      the record), and judged on the other blocks: explains = 1 - SSE_after / SSE_before there
+//   3. the best significant candidate is accepted (statistics.hpp): its held-out gain passes
+//      the signed-rank test over the held-out blocks at 99 %, it explains at least
+//      `min_explains` of the held-out residual and makes no block much worse; creep, which
+//      lives in the holds after steps, may instead pass on held-out holds (each hold refitted
+//      without it: the movement within the holds explained, in two or more), and a hysteresis
+//      operator, which can draw any level, must also leave the held-out holds no worse; of
+//      candidates explaining about as much, the simplest wins; candidates that pass too and
+//      explain nearly as much are reported as alternatives, with their own evidence; then the
+//      search repeats on what is left (several effects in turn), refitting the accepted terms
+//      jointly with each new candidate
 //   4. the accepted corrections go into the model, which the runtime runs per sample.
+//   5. the verdict: mismatch with a finding; without one, unexplained when a channel's residual
+//      stands well above its noise floor (statistics.hpp), else consistent.
 // A model that already carries corrections is diagnosed from its sides alone (its corrections
 // are found again if still needed).
 #pragma once

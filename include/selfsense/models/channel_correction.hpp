@@ -122,6 +122,9 @@ class CorrectionStage {
 
   // Forward: the corrected output for this sample.
   double step(const Inputs& in) noexcept;
+  // The filters alone (dynamics, leakage, delay) on v, as step() runs them after the terms:
+  // for a correction that has no terms (identification filters each regressor column so).
+  double filter(double v) noexcept;
   // Sensed-channel inverse (only for invertible() corrections): the model output y that
   // explains the measurement `measured` at this sample; `in.y` is ignored, the drive must
   // already be delayed by the caller (delay_samples()) and, with creep terms, `in.response` is

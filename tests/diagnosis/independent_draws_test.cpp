@@ -1,0 +1,323 @@
+// The independent actuator (diagnosis/independent/actuator.hpp) and a fixed sample of proof
+// draws on it (draws.hpp; issue 23, item 4). The generator's physics is checked here against
+// figures computed apart from it; the draws assert only what holds by construction (the
+// calibrated ratio, finite figures) and print each outcome: the rates the proof asserts are
+// measured by tests/bench/diagnosis_draws on 100 draws per effect.
+//
+// Seeds: this sample uses kSampleSeedBase + i; 900000 + i is the development range.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "diagnosis/independent/actuator.hpp"
+#include "diagnosis/independent/draws.hpp"
+
+namespace selfsense::independent {
+namespace {
+
+constexpr std::uint64_t kSampleSeedBase = 500000;
+
+// The first draw of `effect` from seed `from` on whose form `accept` holds.
+template <typename F>
+Draw find_draw(Effect effect, F&& accept, std::uint64_t from = 1) {
+  for (std::uint64_t seed = from; seed < from + 100; ++seed) {
+    Draw d = make_draw(seed, effect);
+    if (accept(d)) return d;
+  }
+  ADD_FAILURE() << "no draw of " << to_string(effect) << " with that form";
+  return make_draw(from, effect);
+}
+
+double range(const std::vector<double>& x) {
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  return *hi - *lo;
+}
+
+TEST(IndependentActuator, SameSeedSameRecording) {
+  for (Effect e : kEffects) {
+    const Draw a = make_draw(42, e);
+    const Draw b = make_draw(42, e);
+    EXPECT_EQ(a.form, b.form);
+    EXPECT_EQ(describe(a), describe(b));
+    for (int x = 0; x < 2; ++x) {
+      const Recording ra = record(a, {.excitation = x});
+      const Recording rb = record(b, {.excitation = x});
+      EXPECT_EQ(ra.e, rb.e) << to_string(e);
+      EXPECT_EQ(ra.d, rb.d) << to_string(e);
+      EXPECT_EQ(ra.s, rb.s) << to_string(e);
+      EXPECT_EQ(ra.t, rb.t) << to_string(e);
+      EXPECT_EQ(ra.temp, rb.temp) << to_string(e);
+    }
+  }
+  // Another seed, another bench; the validation excitation is not the identification's.
+  const Recording a = record(make_draw(42, Effect::kNone), {});
+  EXPECT_NE(a.e, record(make_draw(43, Effect::kNone), {}).e);
+  EXPECT_NE(a.e, record(make_draw(42, Effect::kNone), {.excitation = 1}).e);
+}
+
+// What the recordings look like: rates, ranges and durations of a piezo stack bench.
+TEST(IndependentActuator, RecordingsHaveTheBenchMagnitudes) {
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    const Draw d = make_draw(seed, Effect::kNone);
+    EXPECT_GE(d.sample_rate_hz, 1000.0);
+    EXPECT_LE(d.sample_rate_hz, 2000.0);
+    for (int x = 0; x < 2; ++x) {
+      const Recording r = record(d, {.excitation = x});
+      const double seconds = r.sample_time * static_cast<double>(r.e.size());
+      EXPECT_GE(seconds, 60.0);
+      EXPECT_LE(seconds, 90.0);
+      EXPECT_LE(r.e.size(), 200000U);
+      EXPECT_GT(*std::max_element(r.e.begin(), r.e.end()), 1.5e6);
+      EXPECT_LT(*std::max_element(r.e.begin(), r.e.end()), 2.1e6);
+      EXPECT_GT(*std::min_element(r.e.begin(), r.e.end()), -0.15e6);
+      EXPECT_GT(range(r.d), 0.02);
+      EXPECT_LT(range(r.d), 0.08);
+      EXPECT_GT(range(r.s), 0.9e-3);
+      EXPECT_LT(range(r.s), 2.0e-3);
+      EXPECT_LT(*std::max_element(r.t.begin(), r.t.end()), 0.0);  // always compressed
+      EXPECT_GT(*std::min_element(r.t.begin(), r.t.end()), -8e6);
+      EXPECT_EQ(range(r.temp), 0.0);  // 25 degC without the temperature effect
+    }
+  }
+}
+
+// A triangle sweep 0 -> E_ref -> 0 (third cycle, no stress): the strain loop's width is 10-15 %
+// of the stroke as drawn (8-20 % asserted), and each branch is monotone.
+TEST(IndependentActuator, PreisachLoopIsTenToFifteenPercentOfTheStroke) {
+  constexpr int kPoints = 1000;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    const Draw d = make_draw(seed, Effect::kNone);
+    StackModel stack(d.stack);
+    std::vector<double> up(kPoints + 1);
+    std::vector<double> down(kPoints + 1);
+    for (int cycle = 0; cycle < 3; ++cycle) {
+      for (int i = 0; i <= kPoints; ++i) {
+        up[static_cast<std::size_t>(i)] = stack.step(d.stack.field_ref * i / kPoints, 0.0, {}).s;
+      }
+      for (int i = kPoints; i >= 0; --i) {
+        down[static_cast<std::size_t>(i)] = stack.step(d.stack.field_ref * i / kPoints, 0.0, {}).s;
+      }
+    }
+    double width = 0.0;
+    for (std::size_t i = 0; i < up.size(); ++i) {
+      width = std::max(width, down[i] - up[i]);
+      if (i > 0) {
+        EXPECT_GE(up[i], up[i - 1]) << seed;
+        EXPECT_GE(down[i], down[i - 1]) << seed;
+      }
+    }
+    const double fraction = width / (up.back() - up.front());
+    EXPECT_GE(fraction, 0.08) << seed;
+    EXPECT_LE(fraction, 0.20) << seed;
+    EXPECT_NEAR(fraction, strain_loop_fraction(d.stack), 0.01) << seed;
+    EXPECT_NEAR(up.back() - up.front(), 1.3e-3, 0.25e-3) << seed;  // the stroke
+  }
+}
+
+// The Preisach class: a minor loop returns to the point it left (wiping out), and the output
+// does not depend on the rate.
+TEST(IndependentActuator, PreisachReturnsToTheTurningPoint) {
+  const Density density;
+  Preisach p(density, 2e6);
+  p.step(0.0);
+  p.step(1.6e6);
+  const double left = p.step(0.5e6);
+  p.step(1.1e6);
+  EXPECT_DOUBLE_EQ(p.step(0.5e6), left);
+  p.step(0.8e6);
+  p.step(0.6e6);
+  p.step(0.9e6);
+  EXPECT_DOUBLE_EQ(p.step(0.5e6), left);
+  const double top = p.step(1.6e6);
+  Preisach q(density, 2e6);
+  q.step(0.0);
+  for (int i = 1; i <= 100; ++i)
+    q.step(1.6e6 * i / 100);  // the same path in small steps
+  EXPECT_NEAR(q.step(1.6e6), top, 1e-12);
+  EXPECT_GT(top, left);
+}
+
+// Leakage through the stack's parallel conductance sigma: the measured charge gains
+// sigma * integral(E dt) over the clean one, nothing else changes.
+TEST(IndependentActuator, ConductanceLeakageFollowsTheFieldIntegral) {
+  const Draw d = find_draw(Effect::kLeakage, [](const Draw& x) { return x.leakage.conductance; });
+  const Recording on = record(d, {.noise = false});
+  const Recording off = record(d, {.effect = false, .noise = false});
+  const double eps = d.stack.permittivity + d.stack.polarization / d.stack.field_ref;
+  const double sigma = d.magnitude * eps / d.leakage.tau_s;  // [S/m]
+  double integral = 0.0;
+  double worst = 0.0;
+  for (std::size_t k = 1; k < on.e.size(); ++k) {
+    integral += 0.5 * on.sample_time * (on.e[k] + on.e[k - 1]);
+    worst = std::max(worst, std::abs(on.d[k] - off.d[k] - sigma * integral));
+  }
+  EXPECT_GT(sigma * integral, 1e-4);  // visible: several times the noise
+  EXPECT_LT(worst, 1e-9 * sigma * integral);
+  EXPECT_EQ(on.s, off.s);
+  EXPECT_EQ(on.e, off.e);
+}
+
+// A high-pass on the charge with tau: m' = D' - m / tau, so the measured charge falls behind the
+// clean one by integral(m dt) / tau.
+TEST(IndependentActuator, HighPassLeakageLosesChargeAtTheRateOneOverTau) {
+  const Draw d = find_draw(Effect::kLeakage, [](const Draw& x) { return !x.leakage.conductance; });
+  const Recording on = record(d, {.noise = false});
+  const Recording off = record(d, {.effect = false, .noise = false});
+  const double tau = d.leakage.tau_s / d.magnitude;
+  double integral = 0.0;
+  double worst = 0.0;
+  for (std::size_t k = 1; k < on.d.size(); ++k) {
+    integral += 0.5 * on.sample_time * (on.d[k] + on.d[k - 1]);
+    worst = std::max(worst, std::abs(on.d[k] - off.d[k] + integral / tau));
+  }
+  EXPECT_GT(integral / tau, 1e-4);  // visible: several times the noise
+  EXPECT_LT(worst, 1e-3 * integral / tau);
+  EXPECT_EQ(on.s, off.s);
+}
+
+// Delay: the channel sampled `samples` late.
+TEST(IndependentActuator, DelayShiftsByTheDrawnFraction) {
+  // On a sine, the cubic interpolation is exact to a part in 1e6 at 20 samples per period.
+  constexpr double kW = 2.0 * std::numbers::pi / 20.0;
+  std::vector<double> x(400);
+  for (std::size_t k = 0; k < x.size(); ++k)
+    x[k] = std::sin(kW * static_cast<double>(k));
+  for (double samples : {0.37, 1.0, 2.6}) {
+    const std::vector<double> y = delayed(x, samples);
+    for (std::size_t k = 10; k < x.size() - 10; ++k) {
+      EXPECT_NEAR(y[k], std::sin(kW * (static_cast<double>(k) - samples)), 2e-3) << samples;
+    }
+  }
+  // On a recording: the delay that best maps the clean channel onto the delayed one, found on a
+  // grid of 0.01 samples with linear interpolation over the smooth stretches.
+  for (bool strain : {false, true}) {
+    const Draw d =
+        find_draw(Effect::kDelay, [&](const Draw& c) { return c.delay.on_strain == strain; });
+    const Recording on = record(d, {.noise = false});
+    const Recording off = record(d, {.effect = false, .noise = false});
+    const std::vector<double>& a = strain ? off.s : off.d;
+    const std::vector<double>& b = strain ? on.s : on.d;
+    std::vector<std::size_t> smooth;
+    for (std::size_t k = 20; k + 1 < a.size(); ++k) {
+      const double slope = 0.5 * (a[k + 1] - a[k - 1]);
+      if (std::abs(a[k + 1] - 2.0 * a[k] + a[k - 1]) < 0.01 * std::abs(slope)) smooth.push_back(k);
+    }
+    double best = 0.0;
+    double best_sse = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= 1000; ++i) {
+      const double delta = 0.01 * i;
+      const auto whole = static_cast<std::size_t>(delta);
+      const double f = delta - static_cast<double>(whole);
+      double sse = 0.0;
+      for (std::size_t k : smooth) {
+        const double shifted = (1.0 - f) * a[k - whole] + f * a[k - whole - 1];
+        sse += (b[k] - shifted) * (b[k] - shifted);
+      }
+      if (sse < best_sse) {
+        best_sse = sse;
+        best = delta;
+      }
+    }
+    const double drawn = d.magnitude * d.delay.samples;
+    EXPECT_NEAR(best, drawn, 0.05 + 0.02 * drawn) << d.form;
+    EXPECT_EQ(strain ? on.d : on.s, strain ? off.d : off.s);
+  }
+}
+
+// The clean recording of a draw has the same excitation, temperature and noise; only the
+// channels the effect moves differ, and only when an effect is on.
+TEST(IndependentActuator, TheEffectChangesOnlyItsChannels) {
+  for (Effect e : kEffects) {
+    const Draw d = make_draw(7, e);
+    const Recording on = record(d, {});
+    const Recording off = record(d, {.effect = false});
+    const Recording zero = record(d, {.scale = 0.0});
+    EXPECT_EQ(on.e, off.e);
+    EXPECT_EQ(on.t, off.t);
+    EXPECT_EQ(on.temp, off.temp);
+    EXPECT_EQ(off.d, zero.d);
+    EXPECT_EQ(off.s, zero.s);
+    bool d_moves = e == Effect::kLeakage || e == Effect::kStress || e == Effect::kTemperature ||
+                   e == Effect::kCreepLeakage;
+    bool s_moves = e == Effect::kDynamics;
+    if (e == Effect::kCreep || e == Effect::kCreepLeakage) {
+      d_moves = d_moves || d.creep.on_charge;
+      s_moves = s_moves || d.creep.on_strain;
+    }
+    if (e == Effect::kDelay) (d.delay.on_strain ? s_moves : d_moves) = true;
+    if (e == Effect::kStress) {
+      s_moves = d.stress.coupling_per_pa != 0.0 || d.stress.loop_per_pa != 0.0;
+    }
+    if (e == Effect::kTemperature) {
+      s_moves = d.temperature.linear_per_k[1] != 0.0 || d.temperature.linear_per_k[2] != 0.0;
+    }
+    EXPECT_EQ(on.d != off.d, d_moves) << d.form;
+    EXPECT_EQ(on.s != off.s, s_moves) << d.form;
+    if (e == Effect::kTemperature) {
+      EXPECT_GT(range(on.temp), 9.0);
+    }
+  }
+}
+
+// ---- a fixed sample of proof draws ---------------------------------------------------------
+
+struct Sample {
+  Effect effect{Effect::kNone};
+  std::uint64_t seed{0};
+};
+
+// GoogleTest finds this by its name to print a parameter.
+void PrintTo(const Sample& s, std::ostream* os) {  // NOLINT(readability-identifier-naming)
+  *os << to_string(s.effect) << "_" << s.seed;
+}
+
+class IndependentDraw : public ::testing::TestWithParam<Sample> {};
+
+TEST_P(IndependentDraw, CalibratesDiagnosesAndValidates) {
+  const Sample& s = GetParam();
+  const Outcome o = run_draw(s.seed, s.effect);
+  std::printf("%s\n", summary(o).c_str());
+  for (const Named& e : o.expected)
+    std::printf("    expected: %s on %s\n", e.effect.c_str(), e.channel.c_str());
+  if (s.effect == Effect::kNone) {
+    // Nothing is named on a clean stack (issue 23: "nothing named in the clean case").
+    EXPECT_TRUE(o.findings.empty()) << summary(o);
+  } else {
+    // The calibration reaches the drawn ratio (1.5-5) within 15 % or close to it.
+    EXPECT_GE(o.ratio_achieved, 1.3);
+    EXPECT_LE(o.ratio_achieved, 6.0);
+    EXPECT_FALSE(o.expected.empty());
+  }
+  for (double v : {o.d.before, o.d.after, o.d.clean, o.s.before, o.s.after, o.s.clean}) {
+    EXPECT_TRUE(std::isfinite(v));
+    EXPECT_GT(v, 0.0);
+    EXPECT_LT(v, 0.2);
+  }
+  EXPECT_FALSE(o.verdict.empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(FixedSample, IndependentDraw,
+                         ::testing::Values(Sample{Effect::kNone, kSampleSeedBase},
+                                           Sample{Effect::kNone, kSampleSeedBase + 1},
+                                           Sample{Effect::kCreep, kSampleSeedBase},
+                                           Sample{Effect::kLeakage, kSampleSeedBase},
+                                           Sample{Effect::kStress, kSampleSeedBase},
+                                           Sample{Effect::kTemperature, kSampleSeedBase},
+                                           Sample{Effect::kDynamics, kSampleSeedBase},
+                                           Sample{Effect::kDelay, kSampleSeedBase},
+                                           Sample{Effect::kCreepLeakage, kSampleSeedBase}),
+                         [](const ::testing::TestParamInfo<Sample>& p) {
+                           return std::string(to_string(p.param.effect)) + "_" +
+                                  std::to_string(p.param.seed);
+                         });
+
+}  // namespace
+}  // namespace selfsense::independent
