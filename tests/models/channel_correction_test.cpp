@@ -39,6 +39,11 @@ ChannelCorrection sensed_correction() {
   c.hinge_thresholds = {0.0, 5e5};
   c.hinge_levels = {1.2e6, 8e5};
   c.hinge_weights = {3e-10, -2e-10};
+  c.temperature_gain_per_k2 = 2e-5;  // quadratic in the temperature change
+  c.temperature_offset_per_k2 = 1e-7;
+  c.drive_integral_per_s = -3e-9;           // charge lost through a parallel conductance [S/m]
+  c.drive_creep_eigenvalues = {50.0, 2.0};  // creep driven by the input
+  c.drive_creep_weights = {1e-10, 2e-10};
   return c;
 }
 
@@ -67,8 +72,9 @@ TransducerModel corrected_model() {
 }
 
 // The reconstruction undoes what the simulation added on the sensed channel: from the
-// simulated D (leakage, delay, gain, offset, temperature, polynomial, plays, creep) it recovers
-// the stress that drove the simulation, a delay later.
+// simulated D (leakage, delay, gain, offset, temperature linear and quadratic, polynomial, plays,
+// creep of the response and of the drive, the field's integral) it recovers the stress that
+// drove the simulation, a delay later.
 TEST(ChannelCorrection, ReconstructionInvertsTheSensedCorrection) {
   TransducerModel m = corrected_model();
   m.strain_correction.reset();
@@ -253,6 +259,8 @@ TEST(ChannelCorrection, ModelFileRoundTripKeepsEveryTermAndTheIdentity) {
   EXPECT_EQ(back.sensed_correction->temperature_drive_per_k,
             m.sensed_correction->temperature_drive_per_k);
   EXPECT_EQ(back.strain_correction->creep_weights, m.strain_correction->creep_weights);
+  EXPECT_EQ(*back.sensed_correction, *m.sensed_correction);  // every term, the newer ones too
+  EXPECT_EQ(*back.strain_correction, *m.strain_correction);
   EXPECT_EQ(parameter_hash(back), parameter_hash(m));
   EXPECT_NE(parameter_hash(back), parameter_hash(test::typical_transducer(kTs)));
 }
