@@ -1,8 +1,6 @@
 // `selfsense diagnose` (contracts.md): locate where a model and a recording differ, name the
 // physics the model leaves out, model it, write the improved model, the JSON result and the
 // HTML report, with the fit before and after on the recording and on --validate data.
-#include <malloc.h>
-
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
@@ -12,6 +10,11 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+
+// After the standard headers, which define __GLIBC__.
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include "commands.hpp"
 #include "diagnose_report.hpp"
@@ -83,8 +86,10 @@ void run(const DiagnoseOptions& opt) {
   // The diagnosis allocates and frees columns of a whole recording (8 MB at 1e6 samples) for
   // every candidate it fits; glibc would map each from the kernel afresh and fault every page
   // in again (a third of the time on the 1e6-sample bench). Kept in the heap, they are reused.
+#ifdef __GLIBC__
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
   const models::TransducerModel model = models::load_model(opt.model);
   const FieldSignals rec = load_signals(opt.recording, model);
   if (rec.sensed(model.drive()).empty() && rec.s.empty()) {
@@ -178,13 +183,14 @@ void run(const DiagnoseOptions& opt) {
   for (const diagnosis::Unexplained& u : result.unexplained) {
     const std::vector<ReportSegment> where = seconds(u.where, rec.t);
     char line[256];
-    std::snprintf(line, sizeof line,
-                  "%s: residual RMS %.3g, %.1fx its noise floor %.3g; %.0f %% of it in %zu "
-                  "stretch(es) between %.3g s and %.3g s; no candidate reduces it on held-out data",
-                  u.channel.c_str(), u.residual_rms,
-                  u.noise_floor > 0.0 ? u.residual_rms / u.noise_floor : 0.0, u.noise_floor,
-                  100.0 * u.share, where.size(), where.empty() ? 0.0 : where.front().t_start,
-                  where.empty() ? 0.0 : where.back().t_end);
+    static_cast<void>(std::snprintf(
+        line, sizeof line,
+        "%s: residual RMS %.3g, %.1fx its noise floor %.3g; %.0f %% of it in %zu "
+        "stretch(es) between %.3g s and %.3g s; no candidate reduces it on held-out data",
+        u.channel.c_str(), u.residual_rms,
+        u.noise_floor > 0.0 ? u.residual_rms / u.noise_floor : 0.0, u.noise_floor, 100.0 * u.share,
+        where.size(), where.empty() ? 0.0 : where.front().t_start,
+        where.empty() ? 0.0 : where.back().t_end));
     report.unexplained.emplace_back(line);
   }
   report.t = rec.t;

@@ -62,11 +62,15 @@ void describe_leakage(Finding& f, const Evidence& e) {
                      c.leakage_tau_s) +
                  tail;
   } else {
+    // The stack's conductance passes a current sigma E that the charge amplifier collects too,
+    // so the measured D gains sigma times the field's integral (lost where it is subtracted).
     f.evidence = "the measured " + n +
-                 format(
-                     " loses charge in proportion to the integral of the field (a parallel "
-                     "conductance of the stack: %.3g S/m)",
-                     -c.drive_integral_per_s) +
+                 format(c.drive_integral_per_s >= 0.0
+                            ? " gains charge in proportion to the integral of the field (a "
+                              "parallel conductance of the stack: %.3g S/m)"
+                            : " loses charge in proportion to the integral of the field (%.3g "
+                              "S/m)",
+                        std::abs(c.drive_integral_per_s)) +
                  tail;
   }
   f.feature_name = "time [s]";
@@ -422,11 +426,11 @@ bool lags_move_with_the_step(const std::vector<double>& eigenvalues,
   return peak > 0.0 && lowest >= -0.05 * peak && final_value >= 0.5 * peak;
 }
 
-// Both forms of creep (lags of the response, lags of the drive): each bank present moves with
-// the step (the drive raises D and S, so the drive's lags must push the same way).
-
 }  // namespace
 
+// Both forms of creep (lags of the response, lags of the drive): each bank present moves with
+// the step (the drive raises D and S, so the drive's lags must push the same way; a channel of
+// inverted polarity would need the slope's sign first, which no channel here has).
 bool creep_moves_with_the_step(const ChannelCorrection& c) {
   if (c.creep_eigenvalues.empty() && c.drive_creep_eigenvalues.empty()) return false;
   return (c.creep_eigenvalues.empty() ||

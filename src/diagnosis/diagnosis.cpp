@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "channel_data.hpp"
 #include "held_out.hpp"
@@ -85,6 +86,11 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     throw std::invalid_argument(
         "diagnose: needs at least 100 samples of the drive, channels of equal length and a "
         "sample time");
+  }
+  // Half the blocks judge; the signed-rank test reaches p <= 0.01 from 7 of them.
+  if (options.blocks < 14) {
+    throw std::invalid_argument("diagnose: Options.blocks: " + std::to_string(options.blocks) +
+                                " leaves fewer than 7 held-out blocks; nothing could be named");
   }
   models::TransducerModel base = model;
   base.sensed_correction.reset();

@@ -239,6 +239,7 @@ void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& fi
     st.accepted_terms = terms;
     st.accepted = joint.correction;
     st.current = joint.output;
+    st.current_sse = sse_over(in.ch.recorded, st.current, in.rows.judge);
   }
 }
 

@@ -27,7 +27,10 @@ GainTest paired_gain_test(std::span<const double> before, std::span<const double
   GainTest out;
   std::vector<double> gains;
   for (std::size_t i = 0; i < before.size() && i < after.size(); ++i) {
-    if (before[i] > 0.0) gains.push_back(before[i] - after[i]);
+    if (!(before[i] > 0.0)) continue;
+    const double g = before[i] - after[i];
+    if (!std::isfinite(g)) return out;  // a fit that is not finite somewhere gains nothing
+    gains.push_back(g);
   }
   const std::size_t n = gains.size();
   out.blocks = n;

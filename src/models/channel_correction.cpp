@@ -283,13 +283,13 @@ double CorrectionStage::play_terms(double drive) noexcept {
   return sum;
 }
 
-double CorrectionStage::drive_memory_terms(double drive) noexcept {
+double CorrectionStage::drive_memory_terms(double drive, double integral_start) noexcept {
   if (drive_creep_count_ == 0 && c_.drive_integral_per_s == 0.0) return 0.0;
   if (!memory_started_) {
     memory_started_ = true;
     x0_ = drive;
     u_.fill(drive);
-    integral_ = 0.0;
+    integral_ = integral_start;
   } else {
     integral_ += ts_ * drive;
   }
@@ -311,7 +311,7 @@ double CorrectionStage::step(const Inputs& in) noexcept {
   }
   double v = in.y * gain_at(in) + c_.stress_gain_per_pa * in.stress * in.response +
              c_.stress_quadratic_per_pa2 * in.stress * in.stress + terms(in) +
-             play_terms(in.drive) + drive_memory_terms(in.drive);
+             play_terms(in.drive) + drive_memory_terms(in.drive, 0.0);
   for (std::size_t j = 0; j < creep_count_; ++j) {
     z_[j] += alpha_[j] * (in.response - z_[j]);
     v += c_.creep_weights[j] * (z_[j] - y0_);
@@ -364,7 +364,9 @@ double CorrectionStage::invert(double measured, const Inputs& in) noexcept {
     z_[j] += alpha_[j] * (in.response - z_[j]);
     creep += c_.creep_weights[j] * (z_[j] - y0_);
   }
-  return (w - terms(in) - play_terms(in.drive) - drive_memory_terms(in.drive) - creep) /
+  // The drive is delayed: its line starts full of x0, which the integral must not count.
+  return (w - terms(in) - play_terms(in.drive) -
+          drive_memory_terms(in.drive, -c_.delay_s * in.drive) - creep) /
          gain_at(in);
 }
 

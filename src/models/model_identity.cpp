@@ -1,6 +1,8 @@
 #include "selfsense/models/model_identity.hpp"
 
 #include <bit>
+#include <cstdint>
+#include <iterator>
 #include <span>
 
 namespace selfsense::models {
@@ -76,9 +78,13 @@ void add_correction(Fnv1a& h, const std::optional<ChannelCorrection>& c) noexcep
   }
   if (c->drive_linear != 0.0) h.add(c->drive_linear);  // likewise for corrections without it
   // Terms added later: hashed only when used, so older corrections keep their identity.
-  for (const double x :
-       {c->temperature_gain_per_k2, c->temperature_offset_per_k2, c->drive_integral_per_s}) {
-    if (x != 0.0) h.add(x);
+  // Each tagged by its place, so one value in another of them is another identity.
+  const double later[] = {c->temperature_gain_per_k2, c->temperature_offset_per_k2,
+                          c->drive_integral_per_s};
+  for (std::uint64_t i = 0; i < std::size(later); ++i) {
+    if (later[i] == 0.0) continue;
+    h.add(std::uint64_t{0x5e1f0000} + i);
+    h.add(later[i]);
   }
   if (!c->drive_creep_eigenvalues.empty()) {
     h.add(c->drive_creep_eigenvalues);

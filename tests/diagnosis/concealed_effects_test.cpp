@@ -3,7 +3,7 @@
 // identified on the same plant without it; diagnose names the effect and the validation nrmse
 // of the affected channel (a recording with excitation the diagnosis never saw) falls by at
 // least half, and with a force sensor the self-sensing T_hat (from E and D alone) follows. A
-// clean case is `consistent`; two effects at once are both named.
+// clean case names nothing; two effects at once are both named.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -163,7 +163,7 @@ struct Expected {
 struct Case {
   std::string name;
   std::function<void(plant::PlantConfig&, plant::ExcitationConfig&)> effect;
-  std::vector<Expected> expected;  // empty: the clean case, verdict consistent
+  std::vector<Expected> expected;  // empty: the clean case, nothing named
   bool stress_sensor{true};        // the bench records T
   bool base_hysteresis{true};      // the base plant (and model) has hysteresis
 };
@@ -208,7 +208,7 @@ Outcome run_case(const Case& c) {
                 100 * o.t_after);
   }
   std::printf("[%s] verdict %s; validation D %.3g %% -> %.3g %%, S %.3g %% -> %.3g %%\n",
-              c.name.c_str(), o.result.mismatch ? "mismatch" : "consistent", 100 * o.d_before,
+              c.name.c_str(), diagnosis::to_string(o.result.verdict), 100 * o.d_before,
               100 * o.d_after, 100 * o.s_before, 100 * o.s_after);
   for (const diagnosis::Finding& f : o.result.findings) {
     std::printf("   %s on %s explains %.2f: %s\n", f.effect.c_str(), f.channel.c_str(), f.explains,
@@ -408,7 +408,7 @@ TEST(ConcealedEffectHolds, CreepAfterLargeStepsIsNamedOnHeldOutHolds) {
   EXPECT_EQ(first.channel, "D");
   EXPECT_NE(first.evidence.find("judged on held-out holds"), std::string::npos) << first.evidence;
   EXPECT_LE(after, 0.5 * before);
-  // Without the settling the same bench is consistent (the holds name nothing by chance).
+  // Without the settling the same bench names nothing (the holds name nothing by chance).
   const Recorded clean = settling_holds(
       {1.0e6, 1.005e6, 2.0e6, 1.995e6, 1.99e6, 0.1e6, 0.105e6, 0.11e6}, 20.0, false, 31);
   EXPECT_FALSE(diagnosis::diagnose(base, clean.signals()).mismatch);

@@ -41,7 +41,7 @@ ChannelCorrection sensed_correction() {
   c.hinge_weights = {3e-10, -2e-10};
   c.temperature_gain_per_k2 = 2e-5;  // quadratic in the temperature change
   c.temperature_offset_per_k2 = 1e-7;
-  c.drive_integral_per_s = -3e-9;           // charge lost through a parallel conductance [S/m]
+  c.drive_integral_per_s = 3e-9;            // a parallel conductance's current [S/m]
   c.drive_creep_eigenvalues = {50.0, 2.0};  // creep driven by the input
   c.drive_creep_weights = {1e-10, 2e-10};
   return c;

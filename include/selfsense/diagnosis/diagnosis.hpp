@@ -108,7 +108,7 @@ struct Unexplained {
 };
 
 // mismatch: at least one finding; unexplained: none, but a residual well above the noise floor
-// (Unexplained); consistent: the residual is at the noise floor or nothing significant is left.
+// (Unexplained); consistent: none, and every residual near its noise floor.
 enum class Verdict : std::uint8_t { kConsistent, kMismatch, kUnexplained };
 [[nodiscard]] const char* to_string(Verdict v) noexcept;
 
@@ -122,7 +122,7 @@ struct Result {
 };
 
 // Throws std::invalid_argument on unusable signals (no drive, sizes differ, no referenced
-// output the model has).
+// output the model has) and on Options.blocks < 14 (fewer than 7 blocks to judge on).
 [[nodiscard]] Result diagnose(const models::TransducerModel& model, const Signals& signals,
                               const Options& options = {});
 

@@ -5,12 +5,16 @@
 //   d2[k] = e[k+1] - 2 e[k] + e[k-1],   var(d2) = 6 sigma^2 for white e,
 // taken robustly, sigma = 1.4826 MAD(d2) / sqrt(6): what a model misses moves slowly against the
 // sample rate (its second difference is small) except at a few steps, which the median ignores,
-// while sensor noise is white. This is the residual's spectrum above the excitation's band.
+// while sensor noise is white: it reads the residual near the Nyquist frequency, far above the
+// excitation's band (noise filtered before sampling reads lower; a recording quantised more
+// coarsely than its noise reads 0 and makes any model error stand out).
 //
 // Held-out gain: a candidate refitted without some blocks predicts them; per held-out block b
 // the gain is g_b = SSE_before,b - SSE_after,b. It is significant when Wilcoxon's signed-rank
 // test rejects "the gains are symmetric about zero" one-sided at `kConfidence`: rank |g_b|,
-// W- = the sum of the ranks of the negative gains, p = P(W- <= observed) under the null
+// W- = the sum of the ranks of the gains <= 0 (a block that does not gain counts against it;
+// ties, improbable for real-valued gains, are ranked in order), p = P(W- <= observed) under the
+// null
 // (every sign equally likely: 2^B sign patterns, counted exactly). Only signs and ranks count,
 // so an effect that lives in a few blocks (a delay at the fast moves, leakage late in a run)
 // is as significant as one spread evenly, as long as the other blocks do not get worse; blocks
@@ -37,7 +41,7 @@ struct GainTest {
 };
 
 // The signed-rank test over blocks with SSE before and after (equal sizes); blocks without a
-// residual before are left out.
+// residual before are left out; a non-finite gain makes the test fail (p = 1).
 [[nodiscard]] GainTest paired_gain_test(std::span<const double> before,
                                         std::span<const double> after);
 

@@ -13,8 +13,9 @@
 //                                                                P ~ D - d T)
 //         + sum_j creep_weights_j (z_j - r_0)                    creep (eq. 28: K = L[H])
 //         + sum_j drive_creep_weights_j (u_j - x_0)              creep driven by the input
-//         + drive_integral q                                     charge_leakage through the
-//                                                                stack's parallel conductance
+//         + drive_integral q                                     charge_leakage: the current
+//                                                                through the stack's parallel
+//                                                                conductance
 //         + drive_linear x + sum_i hysteresis_weights_i (p_i - x)
 //                                                                hysteresis (a PI operator of
 //                                                                the drive: its linear play and
@@ -40,7 +41,9 @@
 //
 // Reconstruction needs the inverse on the sensed channel: the leakage is undone
 // (w[k] = w[k-1] + (m[k] - g m[k-1]) / c), a delay moves to the drive, and the additive and
-// gain terms that do not depend on T (the play terms depend on the drive alone; the creep lags
+// gain terms that do not depend on T (the play terms, the drive's lags and its integral depend
+// on the drive alone; the integral of the delayed drive starts at -delay x0, so that it is the
+// forward integral a delay later; the creep lags
 // follow the response r = y - d T, which for the affine models is G_s[x] + y0_s, known from the
 // drive before y: the caller passes it) are solved for y; stress_quadratic is solved with the
 // sensor coupling d after the kernel: d T + q' T^2 = d T_lin (q' = q / (1 + gain terms)). Terms
@@ -48,8 +51,8 @@
 // non-invertible in closed form: invertible() says so and the Reconstruction refuses such a
 // model by name.
 //
-// Real-time safe after construction: step(), invert(), save/restore are noexcept and allocate
-// nothing.
+// Real-time safe after construction: step(), filter(), invert(), save/restore are noexcept and
+// allocate nothing.
 #pragma once
 
 #include <array>
@@ -67,9 +70,11 @@ struct ChannelCorrection {
   double temperature_gain_per_k{0.0};
   double temperature_offset_per_k{0.0};
   double temperature_drive_per_k{0.0};
-  double temperature_gain_per_k2{0.0};
-  double temperature_offset_per_k2{0.0};
-  double drive_integral_per_s{0.0};  // charge lost through a parallel conductance
+  double temperature_gain_per_k2{0.0};    // [1/K^2]
+  double temperature_offset_per_k2{0.0};  // [channel unit / K^2]
+  // Times the field's integral [channel unit / (drive unit s)]: the current through a parallel
+  // conductance of the stack, which the charge amplifier collects (sigma [S/m] for D).
+  double drive_integral_per_s{0.0};
   double stress_gain_per_pa{0.0};
   double stress_quadratic_per_pa2{0.0};
   double drive_quadratic{0.0};
@@ -79,8 +84,8 @@ struct ChannelCorrection {
   std::vector<double> creep_eigenvalues{};  // [1/s]
   std::vector<double> creep_weights{};
   std::vector<double> drive_creep_eigenvalues{};  // [1/s] (mu_j)
-  std::vector<double> drive_creep_weights{};
-  double dynamics_frequency_hz{0.0};  // 0: none
+  std::vector<double> drive_creep_weights{};      // [channel unit / drive unit]
+  double dynamics_frequency_hz{0.0};              // 0: none
   double dynamics_damping{0.0};
   double leakage_tau_s{0.0};                    // 0: none
   double delay_s{0.0};                          // 0: none
@@ -152,8 +157,9 @@ class CorrectionStage {
   double gain_at(const Inputs& in) const noexcept;
   double filters(double v) noexcept;         // dynamics, leakage, delay
   double play_terms(double drive) noexcept;  // advances the plays; hysteresis + hinge terms
-  // Advances the drive's lags and integral; their terms.
-  double drive_memory_terms(double drive) noexcept;
+  // Advances the drive's lags and integral; their terms. `integral_start`: the integral's value
+  // at the first sample (0 forward; -delay x0 for the delayed drive of the inverse).
+  double drive_memory_terms(double drive, double integral_start) noexcept;
   double delayed(double value) noexcept;
   double push_delayed(std::array<double, kLine>& line, std::size_t& head,
                       double value) const noexcept;
