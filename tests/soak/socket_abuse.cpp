@@ -2,6 +2,7 @@
 
 #include <sys/socket.h>
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -157,7 +158,17 @@ void SocketAbuse::run(std::uint32_t seed) {
         }
         case 3: {  // a pipelined flood, read back: one ok reply per request, in order
           ControlClient c(socket_, kTimeout);
-          const std::size_t n = 50 + random() % 150;
+          // Sized to the status reply: the server keeps at most 256 KiB of unread replies per
+          // client (control_server.hpp, max_output_bytes) and drops a client past that, so the
+          // whole flood stays within half of it (a status with fault details is a few KiB).
+          const std::string first = c.exchange(kStatus);
+          if (refused(first)) {
+            busy();
+            break;
+          }
+          const std::size_t most = std::clamp<std::size_t>(
+              (std::size_t{128} * 1024) / std::max<std::size_t>(first.size(), 1), 10, 200);
+          const std::size_t n = most / 2 + random() % (most / 2);
           std::string batch;
           for (std::size_t i = 0; i < n; ++i)
             batch += std::string(kStatus) + "\n";
