@@ -255,8 +255,11 @@ int run(const Options& o) {
     return 1;
   }
   RssSampler rss(daemon);
-  SocketAbuse abuse(scratch.socket, scratch.max_clients, 2, 12345U);
+  // The driver takes its slot before the abuse starts: a connection made while the abuse holds
+  // every slot is refused by design (max_clients), which is the abuse's test, not the driver's.
   LoopDriver driver(scratch, plan);
+  static_cast<void>(driver.last_status());
+  SocketAbuse abuse(scratch.socket, scratch.max_clients, 2, 12345U);
   const Clock::time_point start = Clock::now();
   Clock::time_point last_hup = start;
   driver.run(o.seconds, [&] {
