@@ -150,6 +150,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     const SearchInput in{ch, cs, s, rows, drive_holds, has_sensor, !field, options};
     search_rounds(in, st, result.findings);
     local_pass(in, st, result.findings);
+    absorbed_pass(in, st, result.findings);
 
     ChannelResult out;
     out.channel = ch.name;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include "text.hpp"
@@ -82,17 +83,17 @@ bool overlaps(const Segment& a, const Segment& b) {
   return a.begin < b.end && b.begin < a.end;
 }
 
-HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
-                             const std::vector<CorrectionTerm>& terms,
-                             const ChannelCorrection& start, const Rows& rows,
-                             const std::vector<double>& current, const std::vector<Segment>& holds,
-                             HoldMeasure measure, const Options& options) {
+namespace {
+
+// The output with each hold predicted by a fit without its group of holds (holds h, h + G, ...);
+// nullopt when some fit has no finite solution.
+std::optional<std::vector<double>> predicted_holds(const identification::CorrectionSignals& cs,
+                                                   const std::vector<CorrectionTerm>& terms,
+                                                   const ChannelCorrection& start, const Rows& rows,
+                                                   const std::vector<double>& current,
+                                                   const std::vector<Segment>& holds) {
   constexpr std::size_t kMaxFolds = 8;
-  HoldJudgement j;
-  j.holds = holds.size();
-  if (holds.size() < 3) return j;
   const std::size_t n = current.size();
-  j.measure = measure;
   const std::size_t groups = std::min(holds.size(), kMaxFolds);
   std::vector<int> fold(n, -1);
   for (std::size_t h = 0; h < holds.size(); ++h) {
@@ -106,16 +107,40 @@ HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
   try {
     outputs = identification::held_out_outputs(cs, terms, start, usable, fold, groups);
   } catch (const std::invalid_argument&) {
-    // No finite fit without some holds: the candidate cannot predict them.
-    j.judged = true;
-    j.explains = -std::numeric_limits<double>::infinity();
-    return j;
+    return std::nullopt;
   }
   std::vector<double> held_out(current);
   for (std::size_t h = 0; h < holds.size(); ++h) {
     const std::vector<double>& out = outputs[h % groups];
     for (std::size_t k = holds[h].begin; k < holds[h].end; ++k)
       held_out[k] = out[k];
+  }
+  return held_out;
+}
+
+}  // namespace
+
+HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
+                             const std::vector<CorrectionTerm>& terms,
+                             const ChannelCorrection& start, const Rows& rows,
+                             const std::vector<double>& current, const std::vector<Segment>& holds,
+                             HoldMeasure measure, const Options& options,
+                             const std::vector<CorrectionTerm>& baseline_terms) {
+  HoldJudgement j;
+  j.holds = holds.size();
+  if (holds.size() < 3) return j;
+  j.measure = measure;
+  const std::optional<std::vector<double>> held_out =
+      predicted_holds(cs, terms, start, rows, current, holds);
+  std::optional<std::vector<double>> baseline = current;
+  if (!baseline_terms.empty()) {
+    baseline = predicted_holds(cs, baseline_terms, ChannelCorrection{}, rows, current, holds);
+  }
+  if (!held_out || !baseline) {
+    // No finite fit without some holds: the candidate cannot predict them.
+    j.judged = true;
+    j.explains = -std::numeric_limits<double>::infinity();
+    return j;
   }
   // The residual's energy in a hold, about its mean in the hold when only movement counts.
   const auto energy = [&](const std::vector<double>& model, const Segment& h) {
@@ -137,8 +162,8 @@ HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
   double total_before = 0.0;
   double total_after = 0.0;
   for (std::size_t h = 0; h < holds.size(); ++h) {
-    before[h] = energy(current, holds[h]);
-    after[h] = energy(held_out, holds[h]);
+    before[h] = energy(*baseline, holds[h]);
+    after[h] = energy(*held_out, holds[h]);
     total_before += before[h];
     total_after += after[h];
   }

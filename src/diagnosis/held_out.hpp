@@ -60,6 +60,8 @@ struct BlockShares {
 //    chance).
 //  - A hysteresis operator (generic: it can draw any level) must also do no harm there: the
 //    residual over the held-out holds no larger than before.
+// The baseline is `current`, or with `baseline_terms` those terms fitted without each hold too
+// (a fair comparison when the candidate carries them).
 // Either way no hold may get worse by more than `max_block_loss` of the larger of its own and
 // the mean hold's residual (a hold that hardly moves is judged against the others, not against
 // its own noise).
@@ -74,12 +76,12 @@ struct HoldJudgement {
   std::size_t holds{0};
 };
 
-[[nodiscard]] HoldJudgement judge_on_holds(const identification::CorrectionSignals& cs,
-                                           const std::vector<identification::CorrectionTerm>& terms,
-                                           const models::ChannelCorrection& start, const Rows& rows,
-                                           const std::vector<double>& current,
-                                           const std::vector<Segment>& holds, HoldMeasure measure,
-                                           const Options& options);
+[[nodiscard]] HoldJudgement judge_on_holds(
+    const identification::CorrectionSignals& cs,
+    const std::vector<identification::CorrectionTerm>& terms,
+    const models::ChannelCorrection& start, const Rows& rows, const std::vector<double>& current,
+    const std::vector<Segment>& holds, HoldMeasure measure, const Options& options,
+    const std::vector<identification::CorrectionTerm>& baseline_terms = {});
 
 // Creep named on the holds (HoldMeasure::kMovement).
 [[nodiscard]] bool creep_passes_on_holds(const HoldJudgement& j, const Options& options);

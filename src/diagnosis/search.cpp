@@ -243,4 +243,95 @@ void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& fi
   }
 }
 
+void absorbed_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& findings) {
+  const bool named = std::any_of(findings.begin(), findings.end(),
+                                 [&](const Finding& f) { return f.channel == in.ch.name; });
+  if (named || !(st.current_sse > 0.0)) return;
+  // The model's own loop, refitted beside each candidate: gain, offset and a PI operator of the
+  // drive (the span of a hysteresis model's weights).
+  const std::vector<CorrectionTerm> own{CorrectionTerm::kOffset, CorrectionTerm::kHysteresis};
+  identification::CorrectionFit refit;
+  try {
+    refit = identification::fit_correction(in.cs, own, ChannelCorrection{}, in.rows.fit);
+  } catch (const std::invalid_argument&) {
+    return;
+  }
+  const double refit_sse = sse_over(in.ch.recorded, refit.output, in.rows.judge);
+  if (!(refit_sse > 0.0)) return;
+  struct Passed {
+    const Candidate* candidate;
+    identification::CorrectionFit fit;
+    std::vector<CorrectionTerm> terms;
+    ChannelCorrection start;
+    double explains;  // of the refit's held-out residual
+    double sse;
+  };
+  std::vector<Passed> passed;
+  for (const Candidate& c : candidates()) {
+    if (c.generic || !applicable(c, in.ch, in.s, in.has_sensor, in.charge_drive)) continue;
+    std::vector<CorrectionTerm> terms = merged(own, c.terms);
+    try {
+      ChannelCorrection start;
+      if (searches_filter(c, start)) {
+        // The filter's parameters on what the refit leaves, then every coefficient jointly.
+        identification::CorrectionSignals on_refit = in.cs;
+        on_refit.y = refit.output;
+        start = identification::fit_correction(on_refit, c.terms, ChannelCorrection{}, in.rows.fit)
+                    .correction;
+      }
+      identification::CorrectionFit fit =
+          identification::fit_correction(in.cs, terms, start, in.rows.fit);
+      if (std::abs(fit.correction.gain) > in.options.max_gain) continue;
+      if (is_creep(c) && !creep_moves_with_the_step(fit.correction)) continue;
+      const double sse = sse_over(in.ch.recorded, fit.output, in.rows.judge);
+      const double explains = 1.0 - sse / refit_sse;
+      // Significant against the refit alone, and better than the model as it stands.
+      if (explains < in.options.min_explains || sse >= st.current_sse ||
+          (st.current_sse - sse) < in.options.min_share * st.original_sse ||
+          !passes_blocks(block_explains(in.ch.recorded, refit.output, fit.output, in.rows),
+                         in.options)) {
+        continue;
+      }
+      passed.push_back({&c, std::move(fit), std::move(terms), start, explains, sse});
+    } catch (const std::invalid_argument&) {
+      continue;  // no finite fit of this candidate on these signals
+    }
+  }
+  std::sort(passed.begin(), passed.end(),
+            [](const Passed& a, const Passed& b) { return a.explains > b.explains; });
+  // The refitted loop can draw each hold's level from the other half of the same hold: like a
+  // generic candidate, it must do no harm on held-out holds.
+  const auto harmless = [&](const Passed& p) {
+    return in.holds.empty() ||
+           harmless_on_holds(judge_on_holds(in.cs, p.terms, p.start, in.rows, st.current, in.holds,
+                                            HoldMeasure::kLevel, in.options, own),
+                             in.options);
+  };
+  const auto chosen = std::find_if(passed.begin(), passed.end(), harmless);
+  if (chosen == passed.end()) return;
+  Passed& best = *chosen;
+  Finding f;
+  f.effect = best.candidate->effect;
+  f.channel = in.ch.name;
+  f.explains = st.original_sse > 0.0 ? (st.current_sse - best.sse) / st.original_sse : 0.0;
+  const std::size_t n = st.current.size();
+  std::vector<double> change(n);
+  for (std::size_t k = 0; k < n; ++k)
+    change[k] = best.fit.output[k] - st.current[k];
+  f.where = large_segments(change, 1.5, 5);
+  if (f.where.empty()) f.where = {{0, n}};
+  const std::string judged = format(
+      "on held-out blocks, fitted beside a refit of the model's own loop (the model had absorbed "
+      "part of it; against that refit alone it removes %.0f %%)",
+      100.0 * best.explains);
+  describe(f, *best.candidate, best.fit.correction, in.ch, in.s, st.current, best.fit.output,
+           judged);
+  findings.push_back(std::move(f));
+  st.used.push_back(best.candidate);
+  st.accepted_terms = best.terms;
+  st.accepted = best.fit.correction;
+  st.current = best.fit.output;
+  st.current_sse = best.sse;
+}
+
 }  // namespace selfsense::diagnosis::detail

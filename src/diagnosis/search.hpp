@@ -44,4 +44,13 @@ void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>&
 // the accepted terms on the fitting blocks, does not make the held-out blocks worse.
 void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& findings);
 
+// A model identified on the same recording has absorbed what its own terms can imitate: its
+// residual is orthogonal to them over the whole record, so any term near them, fitted on the
+// fitting blocks, loses on the held-out ones. When nothing is named on a channel, each specific
+// candidate is fitted beside a refit of the model's own loop (gain, offset, a PI operator of the
+// drive) and judged against that refit alone on the held-out blocks (the same rules as a round);
+// the best one that also beats the model as it stands is named, its correction carrying the
+// refit.
+void absorbed_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& findings);
+
 }  // namespace selfsense::diagnosis::detail
