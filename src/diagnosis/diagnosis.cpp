@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "channel_data.hpp"
 #include "held_out.hpp"
+#include "reidentified.hpp"
 #include "search.hpp"
 #include "selfsense/diagnosis/statistics.hpp"
 #include "selfsense/models/runtime_model.hpp"
@@ -151,6 +153,15 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     search_rounds(in, st, result.findings);
     local_pass(in, st, result.findings);
     absorbed_pass(in, st, result.findings);
+    if (ch.sensed && std::none_of(result.findings.begin(), result.findings.end(),
+                                  [&](const Finding& f) { return f.channel == ch.name; })) {
+      if (std::optional<Reidentified> r = reidentified_leak(model, s, ch, st.current, options)) {
+        result.findings.push_back(std::move(r->finding));
+        result.improved.sensor = std::move(r->sensor);
+        st.accepted = r->correction;
+        st.current = std::move(r->output);
+      }
+    }
 
     ChannelResult out;
     out.channel = ch.name;
