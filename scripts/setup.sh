@@ -1,13 +1,18 @@
 #!/usr/bin/env bash
 # selfsense set-up on Debian 12: installs what is missing, builds, then runs either the main
-# job on the simulated transducer (`demo`) or every check (`test`). Idempotent and
-# non-interactive; run as root on a fresh machine (apt-get), as any user once installed.
+# job on the simulated transducer (`demo`), every check (`test`) or the Debian packages
+# (`package`). Idempotent and non-interactive; run as root on a fresh machine (apt-get), as any
+# user once installed.
 #
 #   scripts/setup.sh demo   install, build (Release), run the main job (the daemon on the
 #                           simulated transducer; before it the operator demo and self-sensing)
 #   scripts/setup.sh test   install, format check, build (Release, -Werror), unit tests,
 #                           clang-tidy, then build (clang) and test again under ASan + UBSan
-#                           and run every fuzz target for a bounded time
+#                           and run every fuzz target for a bounded time; the Debian packages
+#                           built and read back (tests/package)
+#   scripts/setup.sh package  install, build the programs and libraries (Release, no tests),
+#                           cpack: build/packages/selfsense_VERSION_ARCH.deb and
+#                           libselfsense-dev_VERSION_ARCH.deb (cmake/SelfsensePackage.cmake)
 set -euo pipefail
 
 mode=${1:-demo}
@@ -28,6 +33,11 @@ packages=(
   mbpoll
   rt-tests  # cyclictest beside the loop in tests/bench/loop_timing_bench (docs/benchmarks.md)
 )
+# The Debian packages (cmake/SelfsensePackage.cmake, tests/package): dpkg-shlibdeps (dpkg-dev)
+# computes Depends, lintian reads them back. Not for the demo.
+if [ "$mode" = package ] || [ "$mode" = test ]; then
+  packages+=(dpkg-dev lintian)
+fi
 
 install_missing() {
   local missing=()
@@ -177,8 +187,18 @@ case "$mode" in
     run_thread_sanitizer
     say "all checks passed"
     ;;
+  package)
+    # The programs and libraries only: the tests and benchmarks are not packaged.
+    configure_and_build build-package -DCMAKE_BUILD_TYPE=Release -DSELFSENSE_BUILD_TESTS=OFF \
+      -DSELFSENSE_BUILD_BENCHMARKS=OFF
+    say "package: cpack (DEB) into build/packages/"
+    rm -f build/packages/*.deb
+    mkdir -p build
+    (cd build && cpack --config ../build-package/CPackConfig.cmake -B "$root/build/cpack")
+    ls -l build/packages/
+    ;;
   *)
-    echo "usage: scripts/setup.sh demo|test" >&2
+    echo "usage: scripts/setup.sh demo|test|package" >&2
     exit 2
     ;;
 esac
