@@ -106,6 +106,10 @@ install(FILES ${_pkg}/doc/selfsense/changelog.gz ${PROJECT_SOURCE_DIR}/packaging
 install(FILES ${_pkg}/doc/libselfsense-dev/changelog.gz ${PROJECT_SOURCE_DIR}/packaging/debian/copyright
   DESTINATION /usr/share/doc/libselfsense-dev COMPONENT dev EXCLUDE_FROM_ALL)
 
+# What the packages hold, built without the tests: `cmake --build build --target selfsense_packaged`.
+add_custom_target(selfsense_packaged)
+add_dependencies(selfsense_packaged ${SELFSENSE_EXPORTED_TARGETS})
+
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME selfsense)
 set(CPACK_PACKAGE_VERSION "${_version}")
