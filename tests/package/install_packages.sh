@@ -19,19 +19,13 @@ work=$3
 image=$(bash "$source_dir/scripts/vm/image.sh" --check 2>/dev/null) ||
   { echo "SKIP: no cached VM image; build it with scripts/vm/image.sh (as root)"; exit 77; }
 
-# The packages of package.contents when there, else built here.
+# The packages of package.contents when up to date, else built here.
 arch=$(dpkg --print-architecture)
 version=$(sed -n 's/^set(CPACK_PACKAGE_VERSION "\(.*\)")$/\1/p' "$build/CPackConfig.cmake")
-debs=$build/tests/package/contents/cpack/packages
-runtime=$debs/selfsense_${version}_${arch}.deb
 rm -rf "$work"
 mkdir -p "$work"
-if [ ! -f "$runtime" ] || [ "$runtime" -ot "$build/src/selfsensed/selfsensed" ]; then
-  mkdir -p "$work/cpack"
-  (cd "$work/cpack" && cpack --config "$build/CPackConfig.cmake" -B "$work/cpack") >"$work/cpack.log" 2>&1 ||
-    { tail -30 "$work/cpack.log"; echo "FAIL: cpack"; exit 1; }
-  runtime=$work/cpack/packages/selfsense_${version}_${arch}.deb
-fi
+debs=$(bash "$source_dir/tests/package/packages_dir.sh" "$build" "$work/cpack")
+runtime=$debs/selfsense_${version}_${arch}.deb
 
 # The same package as the next version: an upgrade.
 dpkg-deb -R "$runtime" "$work/next"
