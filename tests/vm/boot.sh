@@ -2,8 +2,10 @@
 # CTest fixture vm.boot: one VM boot that runs every tests/vm/payload/*.sh. It fails only when
 # the VM itself did not report (timeout, panic, no payload); each test's own result is checked
 # by its CTest test (systemd_smoke.sh, can_smoke.sh, ...), so one failure does not hide the
-# others. The PROGRAMs (host-built, e.g. the selfsense tool) go in with their libraries.
-#   tests/vm/boot.sh OUT_DIR [PROGRAM... | --file PATH...]
+# others. The PROGRAMs (host-built, e.g. the selfsense tool) go in with their libraries;
+# --packages BUILD_DIR: the build's Debian packages (tests/package/packages_dir.sh) as
+# /payload/files/packages/.
+#   tests/vm/boot.sh OUT_DIR [PROGRAM... | --file PATH... | --packages BUILD_DIR]
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
@@ -16,6 +18,11 @@ args=(--timeout 420)
 while [ $# -gt 0 ]; do
   if [ "$1" = --file ]; then
     args+=(--file "${2:?--file needs a path}")
+    shift 2
+  elif [ "$1" = --packages ]; then
+    packages=$(bash "$vm_repo/tests/package/packages_dir.sh" "${2:?--packages needs a build directory}" \
+      "$out-packages") || { echo "FAIL: no packages to install in the VM"; exit 1; }
+    args+=(--file "$packages")
     shift 2
   else
     args+=(--program "$1")

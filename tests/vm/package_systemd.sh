@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Host side of payload/package_systemd.sh: the selfsense Debian package installed with apt in the
+# VM, enabled and run by systemd, armed through the installed tool, stopped, removed, purged.
+#   tests/vm/package_systemd.sh OUT_DIR   (after tests/vm/boot.sh OUT_DIR ... --packages BUILD)
+set -euo pipefail
+# shellcheck source-path=SCRIPTDIR source=lib.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
+
+vm_check_test "${1:?usage: tests/vm/package_systemd.sh OUT_DIR}" package_systemd \
+  'installed=install ok installed' \
+  'unit_path=/lib/systemd/system/selfsensed.service' \
+  'user=selfsense,dialout' \
+  'cpu_dma_latency_group=selfsense' \
+  'is-enabled=enabled' \
+  'is-active=active' \
+  'exec_start=/usr/bin/selfsensed' \
+  'cpu_latency_request=held' \
+  'state_after_arm=armed' \
+  'recording=selfsense:selfsense' \
+  'is-active_after_stop=inactive' \
+  'exit_status=0' \
+  'running_after_remove=no' \
+  'enabled_after_remove=no' \
+  'config_after_remove=kept' \
+  'after_purge='
