@@ -208,6 +208,7 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
     const models::TransducerModel whole = judge.identify(judge.undone(best.leak), n);
     if (!whole.sensor) return std::nullopt;
     r.sensor = *whole.sensor;
+    r.base = judge.forecast(whole, models::ChannelCorrection{});
     r.output = judge.forecast(whole, best.leak);
   } catch (const std::invalid_argument&) {
     return std::nullopt;
@@ -226,7 +227,10 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
       "the first half with the leak undone, against the same structure identified on D as "
       "recorded: the model had bent its own operators to the leak)",
       static_cast<double>(n - judge.half()) * s.sample_time);
-  describe(f, leak_candidate(best.leak), best.leak, ch, s, current, r.output, judged);
+  r.candidate = &leak_candidate(best.leak);
+  r.term =
+      best.leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage : CorrectionTerm::kDriveIntegral;
+  describe(f, *r.candidate, best.leak, ch, s, current, r.output, judged);
   return r;
 }
 

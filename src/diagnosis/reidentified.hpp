@@ -27,6 +27,7 @@
 #include <optional>
 #include <vector>
 
+#include "candidates.hpp"
 #include "channel_data.hpp"
 #include "selfsense/diagnosis/diagnosis.hpp"
 
@@ -36,7 +37,10 @@ struct Reidentified {
   Finding finding{};
   models::SideModel sensor{};              // identified with the leak undone
   models::ChannelCorrection correction{};  // the leak
-  std::vector<double> output{};            // the improved model's D over the record
+  identification::CorrectionTerm term{};   // its term (the high-pass or the field's integral)
+  const Candidate* candidate{nullptr};     // its candidate (named once per channel)
+  std::vector<double> base{};              // the re-identified sensor side's D, no leak
+  std::vector<double> output{};            // ... through the leak
 };
 
 // The best form of leak when it is significant; nullopt otherwise (or when the model or the
