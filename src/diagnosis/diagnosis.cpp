@@ -137,7 +137,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     const std::vector<double> model_output = ch.base;  // for the figures before
     // The rounds on one base output of the channel, with a leak found by re-identification
     // (reidentified.hpp) accepted first when given.
-    const auto search = [&](std::optional<Reidentified>& leak, std::vector<Finding>& found) {
+    const auto search = [&](const std::optional<Reidentified>& leak, std::vector<Finding>& found) {
       if (leak) ch.base = leak->base;
       identification::CorrectionSignals cs;
       cs.y = ch.base;
@@ -167,7 +167,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       absorbed_pass(in, st, found);
       return st;
     };
-    std::optional<Reidentified> no_leak;
+    const std::optional<Reidentified> no_leak;
     std::vector<Finding> found;
     SearchState st = search(no_leak, found);
     // A base identified on a recording with a leak has bent its own operators to it: when the

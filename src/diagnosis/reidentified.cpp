@@ -170,6 +170,8 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
       s.sensed.size() != n || n < 1000) {
     return std::nullopt;
   }
+  // Without T the re-identified sensor side would lose the model's stress coupling.
+  if (ch.coupling != 0.0 && s.stress.empty()) return std::nullopt;
   const Judge judge(model, s);
   const Trial null = judge.trial(models::ChannelCorrection{});
   if (null.forecast.empty()) return std::nullopt;

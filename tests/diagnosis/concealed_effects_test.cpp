@@ -129,6 +129,20 @@ models::TransducerModel identify_base(bool stress_sensor, bool hysteresis) {
       s, identification::defaults_for(s));
 }
 
+// The base a user identifies on the very recording they diagnose (hysteresis-creep).
+models::TransducerModel identified_on(const Recorded& r) {
+  const models::Structure s = models::Structure::kHysteresisCreep;
+  return identification::identify({r.e, r.d, r.t, r.s, 1.0 / kRate}, s,
+                                  identification::defaults_for(s));
+}
+
+void print_findings(const diagnosis::Result& result) {
+  for (const diagnosis::Finding& f : result.findings) {
+    std::printf("   %s on %s explains %.2f: %s\n", f.effect.c_str(), f.channel.c_str(), f.explains,
+                f.evidence.c_str());
+  }
+}
+
 const models::TransducerModel& base_model(bool stress_sensor, bool hysteresis) {
   static const models::TransducerModel loaded = identify_base(true, true);
   static const models::TransducerModel free = identify_base(false, true);
@@ -394,10 +408,7 @@ TEST(ConcealedEffectHolds, CreepAfterLargeStepsIsNamedOnHeldOutHolds) {
       settling_holds({0.5e6, 0.505e6, 1.8e6, 1.795e6, 0.3e6, 0.305e6}, 15.0, true, 32);
   const models::TransducerModel& base = base_model(true, false);
   const diagnosis::Result result = diagnosis::diagnose(base, fit.signals());
-  for (const diagnosis::Finding& f : result.findings) {
-    std::printf("   %s on %s explains %.2f: %s\n", f.effect.c_str(), f.channel.c_str(), f.explains,
-                f.evidence.c_str());
-  }
+  print_findings(result);
   const double before = nrmse(val.d, diagnosis::simulate(base, val.signals()).sensed);
   const double after = nrmse(val.d, diagnosis::simulate(result.improved, val.signals()).sensed);
   std::printf("[creep after large steps] validation D %.3g %% -> %.3g %%\n", 100 * before,
@@ -425,11 +436,6 @@ TEST(ConcealedEffectHolds, CreepAfterLargeStepsIsNamedOnHeldOutHolds) {
 // the improved model predicts a recording with new excitation better. The same bench without
 // the effect names nothing.
 TEST(ConcealedEffectAbsorbed, StressCouplingInTheBaseIsNamedBesideItsOwnLoop) {
-  const auto identified_on = [](const Recorded& r) {
-    const models::Structure s = models::Structure::kHysteresisCreep;
-    return identification::identify({r.e, r.d, r.t, r.s, 1.0 / kRate}, s,
-                                    identification::defaults_for(s));
-  };
   plant::PlantConfig p = base_plant();
   plant::ExcitationConfig x = fitting_excitation();
   stress_coupling(p, x);
@@ -438,10 +444,7 @@ TEST(ConcealedEffectAbsorbed, StressCouplingInTheBaseIsNamedBesideItsOwnLoop) {
   const Recorded val = record(p, validation_excitation(), 42);
   const models::TransducerModel base = identified_on(fit);
   const diagnosis::Result result = diagnosis::diagnose(base, fit.signals());
-  for (const diagnosis::Finding& f : result.findings) {
-    std::printf("   %s on %s explains %.2f: %s\n", f.effect.c_str(), f.channel.c_str(), f.explains,
-                f.evidence.c_str());
-  }
+  print_findings(result);
   const double before = nrmse(val.s, diagnosis::simulate(base, val.signals()).strain);
   const double after = nrmse(val.s, diagnosis::simulate(result.improved, val.signals()).strain);
   std::printf("[stress coupling absorbed by the base] validation S %.3g %% -> %.3g %%\n",
@@ -465,11 +468,6 @@ TEST(ConcealedEffectAbsorbed, StressCouplingInTheBaseIsNamedBesideItsOwnLoop) {
 // re-identified with the leak undone predicts new excitation better. The clean bench, its base
 // identified on itself, names nothing.
 TEST(ConcealedEffectReidentified, LeakInTheBaseIsNamedByAForecast) {
-  const auto identified_on = [](const Recorded& r) {
-    const models::Structure s = models::Structure::kHysteresisCreep;
-    return identification::identify({r.e, r.d, r.t, r.s, 1.0 / kRate}, s,
-                                    identification::defaults_for(s));
-  };
   plant::PlantConfig p = base_plant();
   plant::ExcitationConfig x = fitting_excitation();
   leakage(p, x);
@@ -477,10 +475,7 @@ TEST(ConcealedEffectReidentified, LeakInTheBaseIsNamedByAForecast) {
   const Recorded val = record(p, validation_excitation(), 44);
   const models::TransducerModel base = identified_on(fit);
   const diagnosis::Result result = diagnosis::diagnose(base, fit.signals());
-  for (const diagnosis::Finding& f : result.findings) {
-    std::printf("   %s on %s explains %.2f: %s\n", f.effect.c_str(), f.channel.c_str(), f.explains,
-                f.evidence.c_str());
-  }
+  print_findings(result);
   const double before = nrmse(val.d, diagnosis::simulate(base, val.signals()).sensed);
   const double after = nrmse(val.d, diagnosis::simulate(result.improved, val.signals()).sensed);
   std::printf("[leak absorbed by the base] validation D %.3g %% -> %.3g %%\n", 100 * before,
