@@ -469,15 +469,13 @@ std::size_t complexity(const std::vector<CorrectionTerm>& terms) {
       case CorrectionTerm::kDynamics:
         n += 2;
         break;
-      case CorrectionTerm::kTemperature:
-        n += 3;
+      case CorrectionTerm::kTemperature:  // gain, offset, drive, stress (each per K or K^2)
+      case CorrectionTerm::kTemperatureQuadratic:
+        n += 4;
         break;
       case CorrectionTerm::kCreep:
       case CorrectionTerm::kDriveCreep:
         n += 5;
-        break;
-      case CorrectionTerm::kTemperatureQuadratic:
-        n += 2;
         break;
       case CorrectionTerm::kHysteresis:
         n += 9;  // the linear play and 8 plays (correction_fit.cpp)

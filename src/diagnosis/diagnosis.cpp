@@ -135,10 +135,10 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     const Rows rows = make_rows(hold_finite(ch.base), blocks);
     ch.sensed_model = sensed_response;
     const std::vector<double> model_output = ch.base;  // for the figures before
-    // The rounds on one base output of the channel, with a leak found by re-identification
+    // The rounds on one base output of the channel, with an effect found by re-identification
     // (reidentified.hpp) accepted first when given.
-    const auto search = [&](const std::optional<Reidentified>& leak, std::vector<Finding>& found) {
-      if (leak) ch.base = leak->base;
+    const auto search = [&](const std::optional<Reidentified>& reid, std::vector<Finding>& found) {
+      if (reid) ch.base = reid->base;
       identification::CorrectionSignals cs;
       cs.y = ch.base;
       cs.recorded = ch.recorded;
@@ -153,12 +153,12 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       SearchState st;
       st.current = ch.base;
       st.original_sse = sse_over(ch.recorded, model_output, rows.judge);
-      if (leak) {
-        st.accepted = leak->correction;
-        st.accepted_terms = {leak->term};
-        st.used.push_back(leak->candidate);
-        st.current = leak->output;
-        found.push_back(leak->finding);
+      if (reid) {
+        st.accepted = reid->correction;
+        st.accepted_terms = reid->terms;
+        st.used.push_back(reid->candidate);
+        st.current = reid->output;
+        found.push_back(reid->finding);
       }
       st.current_sse = sse_over(ch.recorded, st.current, rows.judge);
       const SearchInput in{ch, cs, s, rows, drive_holds, has_sensor, !field, options};
@@ -167,9 +167,17 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
       absorbed_pass(in, st, found);
       return st;
     };
-    const std::optional<Reidentified> no_leak;
+    const auto accept_side = [&](const Reidentified& reid) {
+      (ch.sensed ? result.improved.sensor : result.improved.actuator) = reid.side;
+    };
+    // A stack that warmed bends a base identified on it (its creep and loop follow the drift):
+    // where the temperature moved, the channel's side is re-identified with the temperature's
+    // terms, and if that forecasts better the rounds run on it.
+    const std::optional<Reidentified> warmed =
+        reidentified_temperature(model, s, ch, model_output, options);
+    if (warmed) accept_side(*warmed);
     std::vector<Finding> found;
-    SearchState st = search(no_leak, found);
+    SearchState st = search(warmed, found);
     // A base identified on a recording with a leak has bent its own operators to it: when the
     // rounds name nothing on the sensed channel, the leak is judged by re-identification, and if
     // it holds the rounds run again on the re-identified sensor side. Not where they name creep:
@@ -181,7 +189,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
         std::vector<Finding> again;
         st = search(leak, again);
         found = std::move(again);
-        result.improved.sensor = leak->sensor;
+        accept_side(*leak);
       }
     }
     result.findings.insert(result.findings.end(), std::make_move_iterator(found.begin()),

@@ -128,9 +128,17 @@ models::ChannelCorrection scaled(models::ChannelCorrection c, double factor) {
   return c;
 }
 
-// Rows: the first half fits, the second half judges in `judging` blocks (the odd block numbers
-// block_explains reads). No block fits between them, so the whole second half judges: the
-// diagnosis's block count there.
+const Candidate& leak_candidate(const models::ChannelCorrection& leak) {
+  const CorrectionTerm term =
+      leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage : CorrectionTerm::kDriveIntegral;
+  for (const Candidate& c : candidates()) {
+    if (uses_term(c, term)) return c;
+  }
+  throw std::logic_error("reidentified_leak: no candidate for the leak");
+}
+
+}  // namespace
+
 Rows forecast_rows(std::size_t n, std::size_t half, std::size_t judging,
                    const std::vector<double>& a, const std::vector<double>& b) {
   Rows r;
@@ -149,17 +157,6 @@ Rows forecast_rows(std::size_t n, std::size_t half, std::size_t judging,
   }
   return r;
 }
-
-const Candidate& leak_candidate(const models::ChannelCorrection& leak) {
-  const CorrectionTerm term =
-      leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage : CorrectionTerm::kDriveIntegral;
-  for (const Candidate& c : candidates()) {
-    if (uses_term(c, term)) return c;
-  }
-  throw std::logic_error("reidentified_leak: no candidate for the leak");
-}
-
-}  // namespace
 
 std::optional<Reidentified> reidentified_leak(const models::TransducerModel& model,
                                               const Signals& s, const ChannelData& ch,
@@ -209,7 +206,7 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
   try {
     const models::TransducerModel whole = judge.identify(judge.undone(best.leak), n);
     if (!whole.sensor) return std::nullopt;
-    r.sensor = *whole.sensor;
+    r.side = *whole.sensor;
     r.base = judge.forecast(whole, models::ChannelCorrection{});
     r.output = judge.forecast(whole, best.leak);
   } catch (const std::invalid_argument&) {
@@ -230,8 +227,8 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
       "recorded: the model had bent its own operators to the leak)",
       static_cast<double>(n - judge.half()) * s.sample_time);
   r.candidate = &leak_candidate(best.leak);
-  r.term =
-      best.leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage : CorrectionTerm::kDriveIntegral;
+  r.terms = {best.leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage
+                                           : CorrectionTerm::kDriveIntegral};
   describe(f, *r.candidate, best.leak, ch, s, current, r.output, judged);
   return r;
 }

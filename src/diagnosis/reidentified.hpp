@@ -29,19 +29,27 @@
 
 #include "candidates.hpp"
 #include "channel_data.hpp"
+#include "held_out.hpp"
 #include "selfsense/diagnosis/diagnosis.hpp"
 
 namespace selfsense::diagnosis::detail {
 
+// An effect judged by re-identification: the channel's side identified with it undone.
 struct Reidentified {
   Finding finding{};
-  models::SideModel sensor{};              // identified with the leak undone
-  models::ChannelCorrection correction{};  // the leak
-  identification::CorrectionTerm term{};   // its term (the high-pass or the field's integral)
-  const Candidate* candidate{nullptr};     // its candidate (named once per channel)
-  std::vector<double> base{};              // the re-identified sensor side's D, no leak
-  std::vector<double> output{};            // ... through the leak
+  models::SideModel side{};                           // identified with the effect undone
+  models::ChannelCorrection correction{};             // the effect
+  std::vector<identification::CorrectionTerm> terms;  // its terms
+  const Candidate* candidate{nullptr};                // its candidate (named once per channel)
+  std::vector<double> base{};                         // the re-identified side's output
+  std::vector<double> output{};                       // ... through the effect
 };
+
+// Rows of a forecast: the first `half` samples fit, the rest judges in `judging` blocks (the odd
+// block numbers block_explains reads). No block fits between them, so the whole second half
+// judges: the diagnosis's block count there. Rows where a or b is not finite are left out.
+[[nodiscard]] Rows forecast_rows(std::size_t n, std::size_t half, std::size_t judging,
+                                 const std::vector<double>& a, const std::vector<double>& b);
 
 // The best form of leak when it is significant; nullopt otherwise (or when the model or the
 // recording does not allow the test).
@@ -49,5 +57,27 @@ struct Reidentified {
                                                             const Signals& s, const ChannelData& ch,
                                                             const std::vector<double>& current,
                                                             const Options& options);
+
+}  // namespace selfsense::diagnosis::detail
+
+namespace selfsense::diagnosis::detail {
+
+// Temperature dependence judged by re-identification too (docs/diagnose.md, "Temperature
+// re-identified"): a base identified on a recording whose stack warmed has bent its creep and
+// loop to the drift, so a correction fitted to its residual learns the bend and carries nothing
+// to new data. The channel's side and the temperature's terms are identified together,
+// alternating three times: the terms fitted on the fitting blocks to the side's residual, the
+// side identified on the whole record with the terms undone (they are affine in the model's
+// output per sample). Null: the side identified on the record as it is. Both sides saw every
+// block; only the terms' few coefficients did not see the held-out ones, where the joint model
+// must beat the null by the rules of a round (signed-rank test at kConfidence, min_explains, no
+// block worse by more than max_block_loss). A forecast of the second half (as for the leak) was
+// tried first: a ramp then extrapolates past the temperatures the first half saw. The quadratic
+// terms replace the linear ones where they beat them on the held-out blocks (test and block
+// rule, no effect size: a nested model). Field-drive models with one side per channel; the
+// recording's temperature must move by more than 1 K.
+[[nodiscard]] std::optional<Reidentified> reidentified_temperature(
+    const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
+    const std::vector<double>& current, const Options& options);
 
 }  // namespace selfsense::diagnosis::detail

@@ -24,6 +24,7 @@ struct Columns {
   std::vector<double> play_thresholds{};
   std::vector<double> hinge_thresholds{};
   std::vector<double> hinge_levels{};
+  bool stress_varies{false};  // the temperature terms carry their stress columns
 };
 
 constexpr std::size_t kCorrectionPlays = 8;
@@ -110,6 +111,9 @@ Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm>
   const auto dtheta = [&](std::size_t k) {
     return at(s.temperature, k, s.temperature_reference_degc) - s.temperature_reference_degc;
   };
+  // A stress that never moves leaves its temperature columns zero (a rank the solve would lose).
+  c.stress_varies = !s.stress.empty() && std::any_of(s.stress.begin(), s.stress.end(),
+                                                     [&](double v) { return v != s.stress[0]; });
   for (const CorrectionTerm t : terms) {
     switch (t) {
       case CorrectionTerm::kOffset:
@@ -120,10 +124,17 @@ Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm>
         add([&](std::size_t k) { return dtheta(k) * s.y[k]; });
         add([&](std::size_t k) { return dtheta(k); });
         add([&](std::size_t k) { return dtheta(k) * s.drive[k]; });
+        // With the output and the drive, the stress's own column lets the coupling move apart
+        // from the loop and the permittivity (each scales its own part of y).
+        if (c.stress_varies) add([&](std::size_t k) { return dtheta(k) * s.stress[k]; });
         break;
       case CorrectionTerm::kTemperatureQuadratic:
         add([&](std::size_t k) { return dtheta(k) * dtheta(k) * s.y[k]; });
         add([&](std::size_t k) { return dtheta(k) * dtheta(k); });
+        add([&](std::size_t k) { return dtheta(k) * dtheta(k) * s.drive[k]; });
+        if (c.stress_varies) {
+          add([&](std::size_t k) { return dtheta(k) * dtheta(k) * s.stress[k]; });
+        }
         break;
       case CorrectionTerm::kStress:
         add([&](std::size_t k) { return at(s.stress, k, 0.0) * at(s.response, k, s.y[k]); });
@@ -217,10 +228,13 @@ void apply_coefficients(std::span<const CorrectionTerm> terms, const Columns& co
         out.temperature_gain_per_k = c[i++];
         out.temperature_offset_per_k = c[i++];
         out.temperature_drive_per_k = c[i++];
+        out.temperature_stress_per_k = columns.stress_varies ? c[i++] : 0.0;
         break;
       case CorrectionTerm::kTemperatureQuadratic:
         out.temperature_gain_per_k2 = c[i++];
         out.temperature_offset_per_k2 = c[i++];
+        out.temperature_drive_per_k2 = c[i++];
+        out.temperature_stress_per_k2 = columns.stress_varies ? c[i++] : 0.0;
         break;
       case CorrectionTerm::kStress:
         out.stress_gain_per_pa = c[i++];

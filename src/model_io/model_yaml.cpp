@@ -126,7 +126,7 @@ std::optional<InputRange> read_range(YamlMap& map, std::string_view key) {
 // The scalar keys of a correction (channel_correction.hpp), shared by reading and writing.
 template <typename C>
 auto correction_scalars(C& c) {
-  return std::array<std::pair<const char*, decltype(&c.gain)>, 19>{{
+  return std::array<std::pair<const char*, decltype(&c.gain)>, 22>{{
       {"gain", &c.gain},
       {"offset", &c.offset},
       {"temperature_reference_degc", &c.temperature_reference_degc},
@@ -134,6 +134,9 @@ auto correction_scalars(C& c) {
       {"temperature_offset_per_k", &c.temperature_offset_per_k},
       {"temperature_drive_per_k", &c.temperature_drive_per_k},
       {"temperature_gain_per_k2", &c.temperature_gain_per_k2},
+      {"temperature_drive_per_k2", &c.temperature_drive_per_k2},
+      {"temperature_stress_per_k", &c.temperature_stress_per_k},
+      {"temperature_stress_per_k2", &c.temperature_stress_per_k2},
       {"temperature_offset_per_k2", &c.temperature_offset_per_k2},
       {"drive_integral_per_s", &c.drive_integral_per_s},
       {"stress_gain_per_pa", &c.stress_gain_per_pa},

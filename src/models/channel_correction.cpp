@@ -25,6 +25,9 @@ bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) co
       {"temperature_drive_per_k", temperature_drive_per_k},
       {"temperature_gain_per_k2", temperature_gain_per_k2},
       {"temperature_offset_per_k2", temperature_offset_per_k2},
+      {"temperature_drive_per_k2", temperature_drive_per_k2},
+      {"temperature_stress_per_k", temperature_stress_per_k},
+      {"temperature_stress_per_k2", temperature_stress_per_k2},
       {"drive_integral_per_s", drive_integral_per_s},
       {"stress_gain_per_pa", stress_gain_per_pa},
       {"stress_quadratic_per_pa2", stress_quadratic_per_pa2},
@@ -146,7 +149,9 @@ bool ChannelCorrection::empty() const noexcept {
   return gain == 0.0 && offset == 0.0 && temperature_gain_per_k == 0.0 &&
          temperature_offset_per_k == 0.0 && temperature_drive_per_k == 0.0 &&
          temperature_gain_per_k2 == 0.0 && temperature_offset_per_k2 == 0.0 &&
-         drive_integral_per_s == 0.0 && drive_creep_weights.empty() && stress_gain_per_pa == 0.0 &&
+         temperature_drive_per_k2 == 0.0 && temperature_stress_per_k == 0.0 &&
+         temperature_stress_per_k2 == 0.0 && drive_integral_per_s == 0.0 &&
+         drive_creep_weights.empty() && stress_gain_per_pa == 0.0 &&
          stress_quadratic_per_pa2 == 0.0 && drive_quadratic == 0.0 && drive_cubic == 0.0 &&
          drive_linear == 0.0 && sensed_quadratic == 0.0 && creep_weights.empty() &&
          dynamics_frequency_hz == 0.0 && leakage_tau_s == 0.0 && delay_s == 0.0 &&
@@ -224,10 +229,15 @@ double CorrectionStage::terms(const Inputs& in) const noexcept {
   const double x = in.drive;
   return c_.offset +
          (c_.temperature_offset_per_k + c_.temperature_drive_per_k * x +
-          c_.temperature_offset_per_k2 * dtheta) *
+          (c_.temperature_offset_per_k2 + c_.temperature_drive_per_k2 * x) * dtheta) *
              dtheta +
          c_.drive_linear * x + c_.drive_quadratic * x * x + c_.drive_cubic * x * x * x +
          c_.sensed_quadratic * in.sensed * in.sensed;
+}
+
+double CorrectionStage::stress_coupling_change(const Inputs& in) const noexcept {
+  const double dtheta = in.temperature - c_.temperature_reference_degc;
+  return (c_.temperature_stress_per_k + c_.temperature_stress_per_k2 * dtheta) * dtheta;
 }
 
 // Writes `value` into a ring and reads it back the configured delay later (linear interpolation
@@ -310,8 +320,8 @@ double CorrectionStage::step(const Inputs& in) noexcept {
       z_[j] = in.response;
   }
   double v = in.y * gain_at(in) + c_.stress_gain_per_pa * in.stress * in.response +
-             c_.stress_quadratic_per_pa2 * in.stress * in.stress + terms(in) +
-             play_terms(in.drive) + drive_memory_terms(in.drive, 0.0);
+             (c_.stress_quadratic_per_pa2 * in.stress + stress_coupling_change(in)) * in.stress +
+             terms(in) + play_terms(in.drive) + drive_memory_terms(in.drive, 0.0);
   for (std::size_t j = 0; j < creep_count_; ++j) {
     z_[j] += alpha_[j] * (in.response - z_[j]);
     v += c_.creep_weights[j] * (z_[j] - y0_);
@@ -372,12 +382,15 @@ double CorrectionStage::invert(double measured, const Inputs& in) noexcept {
 
 double CorrectionStage::solve_stress(double t_lin, double coupling,
                                      const Inputs& in) const noexcept {
-  if (c_.stress_quadratic_per_pa2 == 0.0 || coupling == 0.0) return t_lin;
-  const double q = c_.stress_quadratic_per_pa2 / gain_at(in);
-  // q T^2 + d T - d T_lin = 0, the root that tends to T_lin as q -> 0 (no cancellation).
-  const double disc = coupling * coupling + 4.0 * q * coupling * t_lin;
-  if (!(disc >= 0.0)) return -coupling / (2.0 * q);  // past the vertex: the nearest stress
-  return 2.0 * coupling * t_lin / (coupling + std::copysign(std::sqrt(disc), coupling));
+  const double change = stress_coupling_change(in);
+  if ((c_.stress_quadratic_per_pa2 == 0.0 && change == 0.0) || coupling == 0.0) return t_lin;
+  const double g = gain_at(in);
+  const double q = c_.stress_quadratic_per_pa2 / g;
+  const double b = coupling + change / g;
+  // q T^2 + b T - d T_lin = 0, the root that tends to d T_lin / b as q -> 0 (no cancellation).
+  const double disc = b * b + 4.0 * q * coupling * t_lin;
+  if (!(disc >= 0.0)) return -b / (2.0 * q);  // past the vertex: the nearest stress
+  return 2.0 * coupling * t_lin / (b + std::copysign(std::sqrt(disc), b));
 }
 
 void CorrectionStage::save_state(std::span<double> out) const noexcept {

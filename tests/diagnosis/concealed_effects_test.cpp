@@ -491,6 +491,20 @@ TEST(ConcealedEffectReidentified, LeakInTheBaseIsNamedByAForecast) {
   EXPECT_FALSE(diagnosis::diagnose(identified_on(clean), clean.signals()).mismatch);
 }
 
+// Where the recording's temperature moves, the side is re-identified with the temperature's terms
+// undone and judged on held-out blocks (reidentified.hpp). A clean stack whose temperature column
+// ramps by 20 K without acting on it, its base identified on that recording, names nothing.
+TEST(ConcealedEffectReidentified, TemperatureThatActsOnNothingIsNotNamed) {
+  plant::ExcitationConfig x = fitting_excitation();
+  x.temperature.start_degc = 22.0;
+  x.temperature.end_degc = 42.0;
+  const Recorded clean = record(base_plant(), x, 45);
+  ASSERT_FALSE(clean.temp.empty());
+  const diagnosis::Result result = diagnosis::diagnose(identified_on(clean), clean.signals());
+  print_findings(result);
+  EXPECT_FALSE(result.mismatch);
+}
+
 TEST(ConcealedEffectHolds, HysteresisThatOnlyDrawsTheHoldLevelsIsNotNamed) {
   const auto holds = [](std::vector<double> levels, double hold_s, bool creep, std::uint64_t seed) {
     plant::PlantConfig config = base_plant();

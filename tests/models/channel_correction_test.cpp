@@ -41,6 +41,9 @@ ChannelCorrection sensed_correction() {
   c.hinge_weights = {3e-10, -2e-10};
   c.temperature_gain_per_k2 = 2e-5;  // quadratic in the temperature change
   c.temperature_offset_per_k2 = 1e-7;
+  c.temperature_drive_per_k2 = 2e-13;
+  c.temperature_stress_per_k = 1e-13;  // the coupling moves with the temperature [C/m^2/(Pa K)]
+  c.temperature_stress_per_k2 = -2e-15;
   c.drive_integral_per_s = 3e-9;            // a parallel conductance's current [S/m]
   c.drive_creep_eigenvalues = {50.0, 2.0};  // creep driven by the input
   c.drive_creep_weights = {1e-10, 2e-10};
@@ -249,6 +252,42 @@ TEST(ChannelCorrection, StressQuadraticIsSolvedInTheReconstruction) {
   }
   EXPECT_LT(worst, 1e-6 * range);
   EXPECT_GT(worst_ignorant, 100.0 * worst);  // the term matters: without it T_hat is off
+}
+
+// A coupling that moves with the temperature, (d + k1 dtheta + k2 dtheta^2) T on D: the
+// reconstruction divides it out after the kernel (solve_stress), the stress comes back exactly.
+TEST(ChannelCorrection, TemperatureStressCouplingIsSolvedInTheReconstruction) {
+  TransducerModel m = test::typical_transducer(kTs);
+  const double d = m.sensor->linear_gains.front();
+  ChannelCorrection c;
+  c.temperature_gain_per_k = 2e-3;
+  c.temperature_drive_per_k2 = 1e-13;
+  c.temperature_stress_per_k = 3e-3 * d;  // the coupling +0.3 %/K apart from the loop's 0.2 %/K
+  c.temperature_stress_per_k2 = -4e-5 * d;
+  m.sensed_correction = c;
+  const test::TransducerData data = test::transducer_data(m, 3000, kTs, 8);
+  TransducerModel plain = m;
+  plain.sensed_correction->temperature_stress_per_k = 0.0;
+  plain.sensed_correction->temperature_stress_per_k2 = 0.0;
+  Simulation sim(m);
+  Reconstruction rec(m);
+  Reconstruction ignorant(plain);
+  double worst = 0.0;
+  double worst_ignorant = 0.0;
+  double range = 0.0;
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    const double theta = 25.0 + 15.0 * static_cast<double>(k) / 3000.0;  // warming by 15 K
+    sim.set_temperature(theta);
+    rec.set_temperature(theta);
+    ignorant.set_temperature(theta);
+    const double dk = sim.step(data.e[k], data.t[k]).sensed;
+    worst = std::max(worst, std::abs(rec.step(data.e[k], dk).stress - data.t[k]));
+    worst_ignorant =
+        std::max(worst_ignorant, std::abs(ignorant.step(data.e[k], dk).stress - data.t[k]));
+    range = std::max(range, std::abs(data.t[k]));
+  }
+  EXPECT_LT(worst, 1e-6 * range);
+  EXPECT_GT(worst_ignorant, 100.0 * worst);  // the terms matter: without them T_hat is off
 }
 
 TEST(ChannelCorrection, ModelFileRoundTripKeepsEveryTermAndTheIdentity) {

@@ -21,8 +21,8 @@ namespace selfsense::identification {
 
 enum class CorrectionTerm : std::uint8_t {
   kOffset,                // gain and offset
-  kTemperature,           // gain and offset per kelvin
-  kTemperatureQuadratic,  // gain and offset per kelvin squared
+  kTemperature,           // gain, offset, drive and (when it moves) stress per kelvin
+  kTemperatureQuadratic,  // the same per kelvin squared
   kStress,                // gain per pascal (of the drive response)
   kStressQuadratic,       // T^2: a stress-dependent coupling seen on the sensed channel
   kDrivePolynomial,

@@ -5,8 +5,12 @@
 //         + temperature_gain (theta - theta_ref) y
 //         + temperature_offset (theta - theta_ref)               temperature_dependence
 //         + temperature_drive (theta - theta_ref) x
+//         + temperature_stress (theta - theta_ref) T             (a coupling that moves apart
+//                                                                from the loop and permittivity)
 //         + temperature_gain2 (theta - theta_ref)^2 y
 //         + temperature_offset2 (theta - theta_ref)^2            (quadratic in the change)
+//         + temperature_drive2 (theta - theta_ref)^2 x
+//         + temperature_stress2 (theta - theta_ref)^2 T
 //         + stress_gain T r + stress_quadratic T^2               stress_dependence
 //         + drive_quadratic x^2 + drive_cubic x^3                permittivity_nonlinearity
 //         + sensed_quadratic s^2                                 electrostriction (S ~ P^2,
@@ -36,7 +40,8 @@
 // channel's response to the drive alone (so a coupling that changes with stress,
 // d(T) = d (1 + k T), is k T r on S and d k T^2 on D). Units: gain, temperature_gain [1/K],
 // stress_gain [1/Pa] relative, temperature_gain2 [1/K^2]; offset, drive_linear and the
-// polynomial terms in the channel's unit (per unit of the drive to its power); drive_integral in
+// polynomial terms in the channel's unit (per unit of the drive to its power); temperature_stress
+// [channel unit / (Pa K)], temperature_stress2 [channel unit / (Pa K^2)]; drive_integral in
 // the channel's unit per (drive unit s): for D under field drive the conductivity [S/m].
 //
 // Reconstruction needs the inverse on the sensed channel: the leakage is undone
@@ -45,8 +50,10 @@
 // on the drive alone; the integral of the delayed drive starts at -delay x0, so that it is the
 // forward integral a delay later; the creep lags
 // follow the response r = y - d T, which for the affine models is G_s[x] + y0_s, known from the
-// drive before y: the caller passes it) are solved for y; stress_quadratic is solved with the
-// sensor coupling d after the kernel: d T + q' T^2 = d T_lin (q' = q / (1 + gain terms)). Terms
+// drive before y: the caller passes it) are solved for y; stress_quadratic and the temperature's
+// stress terms are solved with the sensor coupling d after the kernel:
+// (d + k') T + q' T^2 = d T_lin (q' = q / g, k' = (temperature_stress + temperature_stress2
+// (theta - theta_ref)) (theta - theta_ref) / g, g = 1 + gain terms). Terms
 // that depend on T or on y's own history (stress_gain, dynamics) make the sensor side
 // non-invertible in closed form: invertible() says so and the Reconstruction refuses such a
 // model by name.
@@ -72,6 +79,9 @@ struct ChannelCorrection {
   double temperature_drive_per_k{0.0};
   double temperature_gain_per_k2{0.0};    // [1/K^2]
   double temperature_offset_per_k2{0.0};  // [channel unit / K^2]
+  double temperature_drive_per_k2{0.0};   // [channel unit / (drive unit K^2)]
+  double temperature_stress_per_k{0.0};   // [channel unit / (Pa K)]
+  double temperature_stress_per_k2{0.0};  // [channel unit / (Pa K^2)]
   // Times the field's integral [channel unit / (drive unit s)]: the current through a parallel
   // conductance of the stack, which the charge amplifier collects (sigma [S/m] for D).
   double drive_integral_per_s{0.0};
@@ -135,8 +145,8 @@ class CorrectionStage {
   // already be delayed by the caller (delay_samples()) and, with creep terms, `in.response` is
   // the sensor's response to that drive alone.
   double invert(double measured, const Inputs& in) noexcept;
-  // After the kernel: the stress that solves the stress_quadratic term, from the kernel's
-  // T_lin and the sensor coupling d (T_lin itself without the term).
+  // After the kernel: the stress that solves the stress_quadratic and temperature-stress terms,
+  // from the kernel's T_lin and the sensor coupling d (T_lin itself without them).
   [[nodiscard]] double solve_stress(double t_lin, double coupling, const Inputs& in) const noexcept;
   // The drive delayed by this channel's delay (reconstruction feeds it to the kernel).
   double delay_drive(double drive) noexcept;
@@ -153,7 +163,9 @@ class CorrectionStage {
   static constexpr std::size_t kStateSize =
       15 + 2 * kMaxCorrectionCreep + kMaxCorrectionPlays + 2 * kLine;
 
-  double terms(const Inputs& in) const noexcept;  // the additive/gain terms except creep
+  double terms(const Inputs& in) const noexcept;  // the additive/gain terms except creep and T
+  // (temperature_stress + temperature_stress2 dtheta) dtheta: the change of the stress coupling.
+  double stress_coupling_change(const Inputs& in) const noexcept;
   double gain_at(const Inputs& in) const noexcept;
   double filters(double v) noexcept;         // dynamics, leakage, delay
   double play_terms(double drive) noexcept;  // advances the plays; hysteresis + hinge terms

@@ -1,0 +1,198 @@
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "candidates.hpp"
+#include "held_out.hpp"
+#include "reidentified.hpp"
+#include "selfsense/identification/transducer_fit.hpp"
+#include "text.hpp"
+
+namespace selfsense::diagnosis::detail {
+namespace {
+
+using identification::CorrectionSignals;
+using identification::CorrectionTerm;
+
+constexpr int kAlternations = 3;  // terms, then side, each time on the other's latest
+
+// The channel's side and temperature terms identified together on the first `samples` samples.
+struct Joint {
+  models::TransducerModel model{};
+  models::ChannelCorrection correction{};
+  std::vector<double> base{};    // the side's output over the whole record
+  std::vector<double> output{};  // ... through the terms
+  double fit_sse{std::numeric_limits<double>::infinity()};  // over the fitting samples
+};
+
+class Identifier {
+ public:
+  Identifier(const models::TransducerModel& model, const Signals& s, const ChannelData& ch)
+      : model_(model), s_(s), ch_(ch) {}
+
+  // The structure's side of this channel identified on `channel` over the first `samples`.
+  [[nodiscard]] models::TransducerModel identify(const std::vector<double>& channel,
+                                                 std::size_t samples) const {
+    const auto first = [samples](std::span<const double> x) {
+      return x.empty() ? x : x.first(samples);
+    };
+    identification::TransducerSignals t;
+    t.drive = first(s_.drive);
+    (ch_.sensed ? t.sensed : t.strain) = std::span<const double>(channel).first(samples);
+    t.stress = first(s_.stress);
+    t.sample_time = s_.sample_time;
+    return identification::identify(t, model_.structure,
+                                    identification::defaults_for(model_.structure));
+  }
+
+  [[nodiscard]] std::vector<double> output_of(const models::TransducerModel& m) const {
+    const Outputs o = simulate(m, s_);
+    std::vector<double> y = ch_.sensed ? o.sensed : o.strain;
+    static_cast<void>(hold_finite(y));
+    return y;
+  }
+
+  [[nodiscard]] CorrectionSignals signals(std::span<const double> y) const {
+    CorrectionSignals cs;
+    cs.y = y;
+    cs.recorded = ch_.recorded;
+    cs.drive = s_.drive;
+    cs.stress = s_.stress;
+    cs.temperature = s_.temperature;
+    cs.sample_time = s_.sample_time;
+    cs.temperature_reference_degc = s_.temperature[0];
+    return cs;
+  }
+
+  // The recording with the terms undone. They are affine in the model's output per sample,
+  // v = a y + b, so a and b come from the terms run on y = 0 and y = 1.
+  [[nodiscard]] std::vector<double> undone(const models::ChannelCorrection& c) const {
+    const std::size_t n = s_.drive.size();
+    const std::vector<double> zero(n, 0.0);
+    const std::vector<double> one(n, 1.0);
+    const std::vector<double> b = identification::apply_correction(signals(zero), c);
+    const std::vector<double> ab = identification::apply_correction(signals(one), c);
+    std::vector<double> out(n);
+    for (std::size_t k = 0; k < n; ++k)
+      out[k] = (ch_.recorded[k] - b[k]) / (ab[k] - b[k]);
+    return out;
+  }
+
+  // Alternates terms (fitted on `rows`) and the side (identified on the whole record with the
+  // terms undone). Throws as identification does.
+  [[nodiscard]] Joint joint(std::span<const CorrectionTerm> terms,
+                            const std::vector<bool>& rows) const {
+    const std::size_t n = s_.drive.size();
+    Joint j;
+    j.model = identify({ch_.recorded.begin(), ch_.recorded.end()}, n);
+    Joint best;
+    for (int i = 0;; ++i) {
+      j.base = output_of(j.model);
+      const identification::CorrectionFit fit =
+          identification::fit_correction(signals(j.base), terms, {}, rows);
+      j.correction = fit.correction;
+      j.output = fit.output;
+      j.fit_sse = fit.fit_sse;
+      // The side minimises its own identification's error on the undone record, not this one:
+      // the alternation need not descend, so the best pass on the fitting rows is kept.
+      if (j.fit_sse < best.fit_sse) best = j;
+      if (i == kAlternations) return best;
+      j.model = identify(undone(j.correction), n);
+    }
+  }
+
+ private:
+  const models::TransducerModel& model_;
+  const Signals& s_;
+  const ChannelData& ch_;
+};
+
+const Candidate& temperature_candidate(bool quadratic) {
+  for (const Candidate& c : candidates()) {
+    if (uses_term(c, CorrectionTerm::kTemperature) &&
+        uses_term(c, CorrectionTerm::kTemperatureQuadratic) == quadratic) {
+      return c;
+    }
+  }
+  throw std::logic_error("reidentified_temperature: no candidate");
+}
+
+}  // namespace
+
+std::optional<Reidentified> reidentified_temperature(const models::TransducerModel& model,
+                                                     const Signals& s, const ChannelData& ch,
+                                                     const std::vector<double>& current,
+                                                     const Options& options) {
+  const std::size_t n = s.drive.size();
+  const bool has_side = ch.sensed ? model.sensor.has_value() : model.actuator.has_value();
+  if (model.drive() != models::Drive::kField || model.vectorial || !has_side || n < 1000 ||
+      s.temperature.size() != n || range_of(s.temperature) <= 1.0) {
+    return std::nullopt;
+  }
+  // Without T the re-identified side would lose the model's stress coupling.
+  if (ch.coupling != 0.0 && s.stress.empty()) return std::nullopt;
+  const Identifier id(model, s, ch);
+  std::vector<double> null_output;
+  Joint best;
+  const Candidate* candidate = nullptr;
+  Rows rows;
+  try {
+    null_output = id.output_of(id.identify({ch.recorded.begin(), ch.recorded.end()}, n));
+    rows = make_rows(hold_finite(null_output), options.blocks);
+    candidate = &temperature_candidate(false);
+    best = id.joint(candidate->terms, rows.fit);
+    // The quadratic terms replace the linear ones where they beat them on the held-out blocks
+    // by the signed-rank test with no block worse by more than max_block_loss (a nested model:
+    // significance, not an effect size).
+    const Candidate& quadratic = temperature_candidate(true);
+    Joint j = id.joint(quadratic.terms, rows.fit);
+    if (passes_blocks(block_explains(ch.recorded, best.output, j.output, rows), options)) {
+      best = std::move(j);
+      candidate = &quadratic;
+    }
+  } catch (const std::invalid_argument&) {
+    return std::nullopt;
+  }
+  const double null_sse = sse_over(ch.recorded, null_output, rows.judge);
+  const double joint_sse = sse_over(ch.recorded, best.output, rows.judge);
+  if (!(null_sse > 0.0)) return std::nullopt;
+  const double explains = 1.0 - joint_sse / null_sse;
+  if (explains < options.min_explains ||
+      !passes_blocks(block_explains(ch.recorded, null_output, best.output, rows), options)) {
+    return std::nullopt;
+  }
+
+  Reidentified r;
+  try {
+    const Joint whole = id.joint(candidate->terms, std::vector<bool>(n, true));
+    const std::optional<models::SideModel>& side =
+        ch.sensed ? whole.model.sensor : whole.model.actuator;
+    if (!side) return std::nullopt;
+    r.side = *side;
+    r.correction = whole.correction;
+    r.base = whole.base;
+    r.output = whole.output;
+  } catch (const std::invalid_argument&) {
+    return std::nullopt;
+  }
+  r.terms = candidate->terms;
+  r.candidate = candidate;
+  Finding& f = r.finding;
+  f.effect = candidate->effect;
+  f.channel = ch.name;
+  f.explains = explains;
+  std::vector<double> change(n);
+  for (std::size_t k = 0; k < n; ++k)
+    change[k] = r.output[k] - current[k];
+  f.where = large_segments(change, 1.5, 5);
+  if (f.where.empty()) f.where = {{0, n}};
+  const std::string judged =
+      "on held-out blocks (the model's structure identified with the temperature's terms "
+      "undone, the terms fitted on the other blocks, against the structure identified on " +
+      ch.name + " as recorded: the model had bent its own operators to the temperature)";
+  describe(f, *candidate, r.correction, ch, s, current, r.output, judged);
+  return r;
+}
+
+}  // namespace selfsense::diagnosis::detail
