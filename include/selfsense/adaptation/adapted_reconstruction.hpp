@@ -1,0 +1,81 @@
+// Self-sensing with the drift of the sensor side estimated online (drift_estimator.hpp): the
+// affine reconstruction (models/reconstructor.hpp) with its parameters scaled by the estimate,
+// sample by sample. Field drive only; a model with diagnosed corrections or a stress-dependent
+// (vectorial) model is refused by name.
+//
+// With epsilon, lambda the estimated changes of permittivity and loop, c = coupling_per_k
+// (theta_eq - reference) and s = compliance_per_k (theta_eq - reference) (units and symbols of
+// drift_estimator.hpp; per side y0 the offset, c0 the linear weight, r = G[E] + y0 the
+// operator's response, H = r - y0 - c0 E):
+//   T_hat = (D - y0_s - (1 + lambda) H_s - (1 + epsilon) c0_s E) / ((1 + c) d_s)       [Pa]
+//   S_hat = y0_a + (1 + lambda) H_a + (1 + c) c0_a E + (1 + s) s_a T_hat               [-]
+// The plant's loop scale acts on both sides alike (so lambda is the actuator's too); the
+// coupling d cannot be told from the stress by E and D, so it follows the equivalent temperature
+// with its coefficient per K.
+//
+// A sample whose inputs are not finite or outside the identification range (widened by
+// range_margin of its span) is rejected as models::Reconstruction rejects it: the operators
+// advance with the last accepted inputs, the estimator learns nothing and drops its anchor.
+//
+// Real-time safe after construction: step(), save_state(), restore_state() are noexcept and
+// allocate nothing.
+#pragma once
+
+#include <cstddef>
+#include <span>
+
+#include "selfsense/adaptation/drift_estimator.hpp"
+#include "selfsense/models/reconstructor.hpp"
+#include "selfsense/models/runtime_model.hpp"
+#include "selfsense/models/sample_status.hpp"
+#include "selfsense/models/transducer_model.hpp"
+
+namespace selfsense::adaptation {
+
+class AdaptedReconstruction final {
+ public:
+  struct Estimate {
+    double stress{0.0};  // T_hat [Pa]
+    double strain{0.0};  // S_hat [-]; NaN without an actuator side
+    models::SampleStatus status{models::SampleStatus::kOk};
+  };
+
+  // sample_time 0: the model's own. Throws std::invalid_argument naming the reason if the
+  // model cannot be adapted (charge drive, vectorial, corrections, no stress coupling) or the
+  // configuration is invalid.
+  AdaptedReconstruction(const models::TransducerModel& model, const DriftEstimatorConfig& config,
+                        double sample_time = 0.0, double range_margin = 0.5);
+
+  Estimate step(double field, double sensed) noexcept;
+
+  [[nodiscard]] Drift drift() const noexcept { return estimator_.drift(); }
+  [[nodiscard]] const DriftEstimator& estimator() const noexcept { return estimator_; }
+  // A measured temperature [degC] sets the drift instead of the estimate (until the next learn).
+  void set_temperature(double degc) noexcept { estimator_.set_temperature(degc); }
+  void set_frozen(bool frozen) noexcept { estimator_.set_frozen(frozen); }
+  [[nodiscard]] const models::StatusCounts& counts() const noexcept { return counts_; }
+  [[nodiscard]] bool has_strain() const noexcept { return kernel_.actuator().has_value(); }
+
+  // The kernel's operator state followed by the estimator's.
+  [[nodiscard]] std::size_t state_size() const noexcept;
+  // False (nothing written or read) if the span's size is not state_size().
+  bool save_state(std::span<double> out) const noexcept;
+  bool restore_state(std::span<const double> in) noexcept;
+
+ private:
+  struct Tag {};
+  AdaptedReconstruction(const models::TransducerModel& model, const DriftEstimatorConfig& config,
+                        double range_margin, Tag /*unused*/);
+  Estimate kernel_step(double field, double sensed, bool accepted) noexcept;
+
+  models::Reconstructor kernel_;
+  DriftEstimator estimator_;
+  models::detail::InputGate gate_{};
+  models::detail::HeldInputs held_{};
+  Estimate last_{};
+  models::StatusCounts counts_{};
+  double c0_s_{0.0};
+  double c0_a_{0.0};
+};
+
+}  // namespace selfsense::adaptation
