@@ -1,5 +1,6 @@
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -43,6 +44,29 @@ double linear_weight(const models::SideOperator& side) noexcept {
 
 }  // namespace
 
+SideSplit::SideSplit(const models::SideOperator& side)
+    : inverse_shape_{operators::DeadZoneSuperposition(side.op().params().superposition).inverse()} {}
+
+SideSplit::Parts SideSplit::split(const models::SideOperator& side, double field,
+                                  double response) const noexcept {
+  const auto& p = side.op().params();
+  double creep = 0.0;
+  const std::size_t cols = p.creep.eigenvalues.size();
+  if (!p.creep.thresholds.empty() && p.creep.thresholds.front() == 0.0) {
+    const std::span<const double> state = side.op().state();
+    const std::size_t lags = state.size() - p.creep.thresholds.size() * cols;
+    for (std::size_t j = 0; j < cols; ++j)
+      creep += p.creep.weights[j] * state[lags + j];
+  }
+  const double linear_in = p.hysteresis.linear_weight * field + creep;
+  const double y_in = inverse_shape_.evaluate(response);
+  const double scale = std::abs(y_in) > 1e-12 * (std::abs(response) + 1e-300)
+                           ? response / y_in
+                           : p.superposition.linear_weight;
+  const double linear = scale * linear_in;
+  return {linear, response - linear};
+}
+
 AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& model,
                                              const DriftEstimatorConfig& config,
                                              double sample_time, double range_margin)
@@ -52,11 +76,11 @@ AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& mode
                                              const DriftEstimatorConfig& config,
                                              double range_margin, Tag /*unused*/)
     : kernel_(model),
+      sensor_split_(*kernel_.sensor()),
       estimator_(config, model.sample_time, linear_weight(*kernel_.sensor())),
       gate_(model.drive_range, model.sensed_range, range_margin),
-      last_{0.0, kNaN, models::SampleStatus::kOk},
-      c0_s_(linear_weight(*kernel_.sensor())),
-      c0_a_(kernel_.actuator() ? linear_weight(*kernel_.actuator()) : 0.0) {
+      last_{0.0, kNaN, models::SampleStatus::kOk} {
+  if (kernel_.actuator()) actuator_split_.emplace(*kernel_.actuator());
   if (!(range_margin >= 0.0)) {
     throw std::invalid_argument{"adaptation: range_margin must be >= 0"};
   }
@@ -85,17 +109,21 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::step(double field, double
 AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field, double sensed,
                                                                    bool accepted) noexcept {
   models::SideOperator& s = *kernel_.sensor();
-  const double h_s = s.step_unloaded(field) - s.offset() - c0_s_ * field;
-  estimator_.step(field, sensed, h_s, accepted);
+  const double response_s = s.step_unloaded(field) - s.offset() - s.quadratic() * field * field;
+  const SideSplit::Parts ps = sensor_split_.split(s, field, response_s);
+  const double l_s = ps.linear;
+  const double h_s = ps.loop + s.quadratic() * field * field;
+  estimator_.step(field, sensed, l_s, h_s, accepted);
   const Drift dr = estimator_.drift();
-  const double unloaded =
-      s.offset() + (1.0 + dr.loop) * h_s + (1.0 + dr.permittivity) * c0_s_ * field;
+  const double unloaded = s.offset() + (1.0 + dr.loop) * h_s + (1.0 + dr.permittivity) * l_s;
   Estimate out{(sensed - unloaded) / ((1.0 + dr.coupling) * s.coupling()), kNaN,
                models::SampleStatus::kOk};
   if (kernel_.actuator()) {
     models::SideOperator& a = *kernel_.actuator();
-    const double h_a = a.step_unloaded(field) - a.offset() - c0_a_ * field;
-    out.strain = a.offset() + (1.0 + dr.loop) * h_a + (1.0 + dr.coupling) * c0_a_ * field +
+    const double response_a = a.step_unloaded(field) - a.offset() - a.quadratic() * field * field;
+    const SideSplit::Parts pa = actuator_split_->split(a, field, response_a);
+    out.strain = a.offset() + a.quadratic() * field * field + (1.0 + dr.loop) * pa.loop +
+                 (1.0 + dr.coupling) * pa.linear +
                  (1.0 + dr.compliance) * a.coupling() * out.stress;
   }
   return out;

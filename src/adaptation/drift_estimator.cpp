@@ -58,15 +58,15 @@ DriftEstimator::DriftEstimator(const DriftEstimatorConfig& config, double sample
         "adaptation: the model's sensor side has no positive linear part (PI linear weight)"};
   }
   ts_ = sample_time_s;
-  c0_ = c0;
   scale_ = 1.0 / (c0 * config_.min_field_step_v_per_m);
   mu_ = 1.0 - 1.0 / config_.memory_updates;
   p_ = {config_.initial_variance, 0.0, 0.0, config_.initial_variance};
 }
 
-bool DriftEstimator::step(double field, double sensed, double loop_part, bool accepted) noexcept {
+bool DriftEstimator::step(double field, double sensed, double linear_part, double loop_part,
+                          bool accepted) noexcept {
   if (!accepted || !std::isfinite(field) || !std::isfinite(sensed) ||
-      !std::isfinite(loop_part)) {
+      !std::isfinite(linear_part) || !std::isfinite(loop_part)) {
     anchored_ = false;
     return false;
   }
@@ -74,6 +74,7 @@ bool DriftEstimator::step(double field, double sensed, double loop_part, bool ac
     anchored_ = true;
     anchor_e_ = field;
     anchor_d_ = sensed;
+    anchor_l_ = linear_part;
     anchor_h_ = loop_part;
     anchor_age_s_ = 0.0;
     return false;
@@ -82,16 +83,18 @@ bool DriftEstimator::step(double field, double sensed, double loop_part, bool ac
   const double de = field - anchor_e_;
   if (std::abs(de) < config_.min_field_step_v_per_m) return false;
   const double dd = sensed - anchor_d_;
+  const double dl = linear_part - anchor_l_;
   const double dh = loop_part - anchor_h_;
   anchor_e_ = field;
   anchor_d_ = sensed;
+  anchor_l_ = linear_part;
   anchor_h_ = loop_part;
   anchor_age_s_ = 0.0;
   if (config_.frozen) return false;
 
-  const double phi0 = c0_ * de * scale_;
+  const double phi0 = dl * scale_;
   const double phi1 = dh * scale_;
-  const double z = (dd - dh - c0_ * de) * scale_;
+  const double z = (dd - dh - dl) * scale_;
   // P phi and the gain.
   const double pp0 = p_[0] * phi0 + p_[1] * phi1;
   const double pp1 = p_[2] * phi0 + p_[3] * phi1;
@@ -144,6 +147,7 @@ void DriftEstimator::save_state(std::span<double> out) const noexcept {
                                      p_[3],
                                      anchor_e_,
                                      anchor_d_,
+                                     anchor_l_,
                                      anchor_h_,
                                      anchor_age_s_,
                                      anchored_ ? 1.0 : 0.0,
@@ -158,10 +162,11 @@ void DriftEstimator::restore_state(std::span<const double> in) noexcept {
   p_ = {in[2], in[3], in[4], in[5]};
   anchor_e_ = in[6];
   anchor_d_ = in[7];
-  anchor_h_ = in[8];
-  anchor_age_s_ = in[9];
-  anchored_ = in[10] != 0.0;
-  updates_ = static_cast<std::size_t>(std::max(0.0, in[11]));
+  anchor_l_ = in[8];
+  anchor_h_ = in[9];
+  anchor_age_s_ = in[10];
+  anchored_ = in[11] != 0.0;
+  updates_ = static_cast<std::size_t>(std::max(0.0, in[12]));
 }
 
 }  // namespace selfsense::adaptation

@@ -14,6 +14,9 @@
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/models/reconstructor.hpp"
+#include "selfsense/model_io/model_yaml.hpp"
+#include <filesystem>
+#include <cstdlib>
 #include "selfsense/plant/plant.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
 
@@ -44,14 +47,18 @@ Recorded record(const plant::PlantConfig& config, const plant::Excitation& ex) {
 // The main job's model: identified at 25 degC on the identification excitation, seed 1.
 const models::TransducerModel& main_job_model() {
   static const models::TransducerModel model = [] {
+    if (const char* cache = std::getenv("ADAPT_CACHE"); cache && std::filesystem::exists(cache))
+      return models::load_model(cache);
     plant::PlantFile f =
         plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction.yaml");
     f.plant.seed = 1;
     const Recorded r = record(f.plant, plant::make_excitation("identification", f.excitation,
                                                               f.plant.sample_rate_hz, 1));
-    return identification::identify(
+    auto m = identification::identify(
         {r.e, r.d, r.t, r.s, 1.0 / f.plant.sample_rate_hz}, models::Structure::kPreisachCreep,
         identification::defaults_for(models::Structure::kPreisachCreep));
+    if (const char* cache = std::getenv("ADAPT_CACHE")) models::save_model(m, cache, {});
+    return m;
   }();
   return model;
 }
@@ -98,12 +105,19 @@ Figures reconstruct(const Recorded& r, int kind, std::size_t settle) {
   } else {
     adaptation::DriftEstimatorConfig config{};
     config.frozen = kind == 2;
+    if (const char* v = std::getenv("ADAPT_MEM")) config.memory_updates = std::atof(v);
+    if (const char* v = std::getenv("ADAPT_STEP")) config.min_field_step_v_per_m = std::atof(v);
+    if (const char* v = std::getenv("ADAPT_INT")) config.max_interval_s = std::atof(v);
     adaptation::AdaptedReconstruction rec(model, config);
     for (std::size_t k = 0; k < r.e.size(); ++k) {
       if (kind == 2) rec.set_temperature(r.temp[k]);
       const auto est = rec.step(r.e[k], r.d[k]);
       s_hat[k] = est.strain;
       t_hat[k] = est.stress;
+      if (kind == 1 && k % 10000 == 0)
+        std::printf("t %.0f s: temp %.1f eq %.1f eps %.4f loop %.4f updates %zu\n", static_cast<double>(k) * 1e-3,
+                    r.temp[k], rec.drift().temperature_degc, rec.drift().permittivity,
+                    rec.drift().loop, rec.estimator().updates());
       if (k >= settle) {
         const double err = rec.drift().temperature_degc - r.temp[k];
         sq += err * err;
@@ -126,9 +140,9 @@ void print(const char* what, const Figures& f) {
 TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
   const Recorded r = warming_recording(21, 25.0, 55.0, 2);
   const std::size_t settle = 20000;  // 20 s at 1 kHz before the temperature error is counted
-  const Figures none = reconstruct(r, 0, settle);
+  const Figures none = std::getenv("ADAPT_ONLY") ? Figures{} : reconstruct(r, 0, settle);
   const Figures adapted = reconstruct(r, 1, settle);
-  const Figures measured = reconstruct(r, 2, settle);
+  const Figures measured = std::getenv("ADAPT_ONLY") ? Figures{} : reconstruct(r, 2, settle);
   print("as identified", none);
   print("adapted (E, D only)", adapted);
   print("recorded temperature", measured);

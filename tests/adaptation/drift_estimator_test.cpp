@@ -18,14 +18,10 @@
 namespace selfsense::adaptation {
 namespace {
 
-static_assert(noexcept(std::declval<DriftEstimator&>().step(0.0, 0.0, 0.0, true)));
+static_assert(noexcept(std::declval<DriftEstimator&>().step(0.0, 0.0, 0.0, 0.0, true)));
 static_assert(noexcept(std::declval<AdaptedReconstruction&>().step(0.0, 0.0)));
 
 constexpr double kTs = 1e-4;
-
-double c0_of(const models::SideModel& side) {
-  return side.op.hysteresis.linear_weight * side.op.superposition.linear_weight;
-}
 
 // The typical transducer whose sensor side drifted by (epsilon, lambda) and coupling by
 // `coupling`: E, D, the true T, and the model with the sensed range it would have recorded.
@@ -39,7 +35,7 @@ Drifted drifted(double epsilon, double lambda, double coupling, std::size_t n,
   Drifted out{test::typical_transducer(kTs), {}, {}, {}};
   const models::SideModel& sensor = *out.model.sensor;
   models::SideOperator truth(sensor);
-  const double c0 = c0_of(sensor);
+  const SideSplit split(truth);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n01;
   double lo = 1e300;
@@ -49,8 +45,8 @@ Drifted drifted(double epsilon, double lambda, double coupling, std::size_t n,
     const double e = 1e6 * (1.0 + 0.9 * std::sin(2 * std::numbers::pi * 3.0 * time) *
                                       std::cos(2 * std::numbers::pi * 0.23 * time));
     const double t = -1e7 * (1.0 + 0.5 * std::sin(2 * std::numbers::pi * 0.2 * time + 0.5));
-    const double h = truth.step_unloaded(e) - sensor.offset - c0 * e;
-    const double d = sensor.offset + (1.0 + lambda) * h + (1.0 + epsilon) * c0 * e +
+    const SideSplit::Parts parts = split.split(truth, e, truth.step_unloaded(e) - sensor.offset);
+    const double d = sensor.offset + (1.0 + lambda) * parts.loop + (1.0 + epsilon) * parts.linear +
                      (1.0 + coupling) * truth.coupling() * t + 2e-6 * n01(rng);
     out.e.push_back(e + 100.0 * n01(rng));
     out.d.push_back(d);
@@ -116,18 +112,18 @@ TEST(DriftEstimator, LearnsNothingOnHoldsRejectedSamplesOrWhenFrozen) {
   DriftEstimator est(DriftEstimatorConfig{}, kTs, 2e-8);
   // A hold: the field within noise of one value.
   for (int k = 0; k < 100000; ++k)
-    EXPECT_FALSE(est.step(1e6 + 100.0 * std::sin(k), 0.03, 0.01, true));
+    EXPECT_FALSE(est.step(1e6 + 100.0 * std::sin(k), 0.03, 2e-2, 0.01, true));
   EXPECT_EQ(est.updates(), 0U);
   // Alternating rejected samples: no increment spans one.
   for (int k = 0; k < 1000; ++k) {
     const double e = 1e6 + 1e5 * (k % 2);
-    EXPECT_FALSE(est.step(e, 0.03 + 2.2e-8 * e, 0.01, k % 2 == 0));
+    EXPECT_FALSE(est.step(e, 0.03 + 2.2e-8 * e, 2e-8 * e, 0.01, k % 2 == 0));
   }
   EXPECT_EQ(est.updates(), 0U);
   // Moving with a drift: it learns; frozen, the same data teaches nothing.
   for (int k = 0; k < 1000; ++k) {
     const double e = 1e6 + 1e5 * (k % 2);
-    est.step(e, 0.03 + 2.2e-8 * e, 0.01, true);
+    est.step(e, 0.03 + 2.2e-8 * e, 2e-8 * e, 0.01, true);
   }
   EXPECT_GT(est.updates(), 900U);
   EXPECT_NEAR(est.drift().permittivity, 0.1, 1e-3);
@@ -136,7 +132,7 @@ TEST(DriftEstimator, LearnsNothingOnHoldsRejectedSamplesOrWhenFrozen) {
   const std::size_t updates = est.updates();
   for (int k = 0; k < 1000; ++k) {
     const double e = 1e6 + 1e5 * (k % 2);
-    est.step(e, 0.03 + 2.6e-8 * e, 0.01, true);
+    est.step(e, 0.03 + 2.6e-8 * e, 2e-8 * e, 0.01, true);
   }
   EXPECT_EQ(est.updates(), updates);
   EXPECT_EQ(est.drift().permittivity, before.permittivity);
@@ -148,7 +144,7 @@ TEST(DriftEstimator, StaysWithinItsBounds) {
   DriftEstimator est(c, kTs, 2e-8);
   for (int k = 0; k < 2000; ++k) {
     const double e = 1e6 + 1e5 * (k % 2);
-    est.step(e, 0.03 + 4e-8 * e, 0.0, true);  // a doubled permittivity
+    est.step(e, 0.03 + 4e-8 * e, 2e-8 * e, 0.0, true);  // a doubled permittivity
   }
   EXPECT_DOUBLE_EQ(est.drift().permittivity, 0.2);
   EXPECT_DOUBLE_EQ(est.drift().temperature_degc, 25.0 + 0.2 / 4e-3);
@@ -203,6 +199,8 @@ TEST(AdaptationRealTime, StepsAndStateSavesDoNotAllocateOrLock) {
   const Drifted data = drifted(0.05, -0.03, 0.02, 5000, 6);
   AdaptedReconstruction rec(data.model, DriftEstimatorConfig{});
   DriftEstimator est(DriftEstimatorConfig{}, kTs, 2e-8);
+  models::Reconstructor plain(data.model);
+  const SideSplit split(*plain.sensor());
   std::vector<double> state(rec.state_size());
   std::vector<double> est_state(DriftEstimator::state_size());
   double sink = 0.0;
@@ -211,7 +209,8 @@ TEST(AdaptationRealTime, StepsAndStateSavesDoNotAllocateOrLock) {
     const AdaptedReconstruction::Estimate out = rec.step(data.e[k], data.d[k]);
     rec.save_state(state);
     rec.restore_state(state);
-    est.step(data.e[k], data.d[k], 0.0, k % 7 != 0);
+    est.step(data.e[k], data.d[k], 2e-8 * data.e[k], 0.0, k % 7 != 0);
+    sink += split.split(*plain.sensor(), data.e[k], plain.sensor()->step_unloaded(data.e[k])).loop;
     est.save_state(est_state);
     est.restore_state(est_state);
     sink += out.stress + out.strain + rec.drift().temperature_degc + est.drift().loop;

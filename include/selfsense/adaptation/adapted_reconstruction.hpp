@@ -22,6 +22,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <span>
 
 #include "selfsense/adaptation/drift_estimator.hpp"
@@ -29,8 +30,31 @@
 #include "selfsense/models/runtime_model.hpp"
 #include "selfsense/models/sample_status.hpp"
 #include "selfsense/models/transducer_model.hpp"
+#include "selfsense/operators/dead_zone_superposition.hpp"
 
 namespace selfsense::adaptation {
+
+// A side's response r = G[E] (without the offset y0) split into its linear capacitive part L
+// and the rest H = r - L (the loop), read after the side's step_unloaded(E):
+//   L_in = w0 E + sum_j c_0j z_0j     the PI's linear weight and the creep of E itself (the
+//                                     lags on creep threshold 0)
+//   y_in = S^-1[r]                    the superposition's input
+//   L = r L_in / y_in                 the superposition shared in proportion (s0 L_in where
+//                                     y_in is about 0)
+// Construction allocates (the superposition's inverse); split() is real-time safe.
+class SideSplit final {
+ public:
+  struct Parts {
+    double linear{0.0};  // L
+    double loop{0.0};    // H
+  };
+  explicit SideSplit(const models::SideOperator& side);
+  [[nodiscard]] Parts split(const models::SideOperator& side, double field,
+                            double response) const noexcept;
+
+ private:
+  operators::DeadZoneSuperposition inverse_shape_;
+};
 
 class AdaptedReconstruction final {
  public:
@@ -69,13 +93,13 @@ class AdaptedReconstruction final {
   Estimate kernel_step(double field, double sensed, bool accepted) noexcept;
 
   models::Reconstructor kernel_;
+  SideSplit sensor_split_;
+  std::optional<SideSplit> actuator_split_{};
   DriftEstimator estimator_;
   models::detail::InputGate gate_{};
   models::detail::HeldInputs held_{};
   Estimate last_{};
   models::StatusCounts counts_{};
-  double c0_s_{0.0};
-  double c0_a_{0.0};
 };
 
 }  // namespace selfsense::adaptation

@@ -78,9 +78,11 @@ class DriftEstimator final {
   // sample time or c0 <= 0.
   DriftEstimator(const DriftEstimatorConfig& config, double sample_time_s, double c0);
 
-  // One sample: the measured field E [V/m] and displacement D [C/m^2], the model's H at E
-  // (header comment) and whether the sample was accepted. Returns true when it updated.
-  bool step(double field, double sensed, double loop_part, bool accepted) noexcept;
+  // One sample: the measured field E [V/m] and displacement D [C/m^2], the model's linear
+  // part L and loop part H at E [C/m^2] (header comment) and whether the sample was accepted.
+  // Returns true when it updated.
+  bool step(double field, double sensed, double linear_part, double loop_part,
+            bool accepted) noexcept;
 
   [[nodiscard]] Drift drift() const noexcept;
   [[nodiscard]] std::size_t updates() const noexcept { return updates_; }
@@ -96,18 +98,18 @@ class DriftEstimator final {
   void restore_state(std::span<const double> in) noexcept;
 
  private:
-  // theta (2), P (4), anchor E, D, H, anchor age, anchored, updates.
-  static constexpr std::size_t kStateSize{12};
+  // theta (2), P (4), anchor E, D, L, H, anchor age, anchored, updates.
+  static constexpr std::size_t kStateSize{13};
 
   DriftEstimatorConfig config_;
   double ts_{0.0};
-  double c0_{0.0};
   double scale_{1.0};  // 1 / (c0 min_field_step)
   double mu_{1.0};
   std::array<double, 2> theta_{};
   std::array<double, 4> p_{};  // row major
   double anchor_e_{0.0};
   double anchor_d_{0.0};
+  double anchor_l_{0.0};
   double anchor_h_{0.0};
   double anchor_age_s_{0.0};
   bool anchored_{false};
