@@ -60,7 +60,7 @@ DriftEstimator::DriftEstimator(const DriftEstimatorConfig& config, double sample
   ts_ = sample_time_s;
   scale_ = 1.0 / (c0 * config_.min_field_step_v_per_m);
   mu_ = 1.0 - 1.0 / config_.memory_updates;
-  p_ = {config_.initial_variance, 0.0, 0.0, config_.initial_variance};
+  p_ = {config_.initial_variance, 0.0, 0.0, config_.learn_loop ? config_.initial_variance : 0.0};
 }
 
 bool DriftEstimator::step(double field, double sensed, double linear_part, double loop_part,
@@ -92,8 +92,9 @@ bool DriftEstimator::step(double field, double sensed, double linear_part, doubl
   anchor_age_s_ = 0.0;
   if (config_.frozen) return false;
 
-  const double phi0 = dl * scale_;
-  const double phi1 = dh * scale_;
+  const double tie = config_.loop_per_k / config_.permittivity_per_k;
+  const double phi0 = (config_.learn_loop ? dl : dl + tie * dh) * scale_;
+  const double phi1 = config_.learn_loop ? dh * scale_ : 0.0;
   const double z = (dd - dh - dl) * scale_;
   // P phi and the gain.
   const double pp0 = p_[0] * phi0 + p_[1] * phi1;
@@ -105,15 +106,17 @@ bool DriftEstimator::step(double field, double sensed, double linear_part, doubl
   const double err = z - (phi0 * theta_[0] + phi1 * theta_[1]);
   const double bound = config_.max_relative_change;
   theta_[0] = std::clamp(theta_[0] + k0 * err, -bound, bound);
-  theta_[1] = std::clamp(theta_[1] + k1 * err, -bound, bound);
+  theta_[1] = config_.learn_loop ? std::clamp(theta_[1] + k1 * err, -bound, bound)
+                                 : std::clamp(tie * theta_[0], -bound, bound);
   // P = (P - K (P phi)') / mu (P symmetric, so phi' P = (P phi)').
   std::array<double, 4> next{(p_[0] - k0 * pp0) / mu_, (p_[1] - k0 * pp1) / mu_,
                              (p_[2] - k1 * pp0) / mu_, (p_[3] - k1 * pp1) / mu_};
-  const double sym = 0.5 * (next[1] + next[2]);
+  const double sym = config_.learn_loop ? 0.5 * (next[1] + next[2]) : 0.0;
   next[1] = sym;
   next[2] = sym;
+  if (!config_.learn_loop) next[3] = 0.0;
   const double trace = next[0] + next[3];
-  const double limit = 2.0 * config_.initial_variance;
+  const double limit = (config_.learn_loop ? 2.0 : 1.0) * config_.initial_variance;
   if (trace > limit) {
     for (double& v : next)
       v *= limit / trace;

@@ -14,9 +14,6 @@
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/models/reconstructor.hpp"
-#include "selfsense/model_io/model_yaml.hpp"
-#include <filesystem>
-#include <cstdlib>
 #include "selfsense/plant/plant.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
 
@@ -47,18 +44,14 @@ Recorded record(const plant::PlantConfig& config, const plant::Excitation& ex) {
 // The main job's model: identified at 25 degC on the identification excitation, seed 1.
 const models::TransducerModel& main_job_model() {
   static const models::TransducerModel model = [] {
-    if (const char* cache = std::getenv("ADAPT_CACHE"); cache && std::filesystem::exists(cache))
-      return models::load_model(cache);
     plant::PlantFile f =
         plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction.yaml");
     f.plant.seed = 1;
     const Recorded r = record(f.plant, plant::make_excitation("identification", f.excitation,
                                                               f.plant.sample_rate_hz, 1));
-    auto m = identification::identify(
+    return identification::identify(
         {r.e, r.d, r.t, r.s, 1.0 / f.plant.sample_rate_hz}, models::Structure::kPreisachCreep,
         identification::defaults_for(models::Structure::kPreisachCreep));
-    if (const char* cache = std::getenv("ADAPT_CACHE")) models::save_model(m, cache, {});
-    return m;
   }();
   return model;
 }
@@ -105,19 +98,12 @@ Figures reconstruct(const Recorded& r, int kind, std::size_t settle) {
   } else {
     adaptation::DriftEstimatorConfig config{};
     config.frozen = kind == 2;
-    if (const char* v = std::getenv("ADAPT_MEM")) config.memory_updates = std::atof(v);
-    if (const char* v = std::getenv("ADAPT_STEP")) config.min_field_step_v_per_m = std::atof(v);
-    if (const char* v = std::getenv("ADAPT_INT")) config.max_interval_s = std::atof(v);
     adaptation::AdaptedReconstruction rec(model, config);
     for (std::size_t k = 0; k < r.e.size(); ++k) {
       if (kind == 2) rec.set_temperature(r.temp[k]);
       const auto est = rec.step(r.e[k], r.d[k]);
       s_hat[k] = est.strain;
       t_hat[k] = est.stress;
-      if (kind == 1 && k % 10000 == 0)
-        std::printf("t %.0f s: temp %.1f eq %.1f eps %.4f loop %.4f updates %zu\n", static_cast<double>(k) * 1e-3,
-                    r.temp[k], rec.drift().temperature_degc, rec.drift().permittivity,
-                    rec.drift().loop, rec.estimator().updates());
       if (k >= settle) {
         const double err = rec.drift().temperature_degc - r.temp[k];
         sq += err * err;
@@ -137,15 +123,79 @@ void print(const char* what, const Figures& f) {
               100 * f.stress.max, f.temperature_rms_k, f.temperature_max_k);
 }
 
+// Measured (seed 21, 25 -> 55 degC over the mix excitation twice, 200 s at 1 kHz):
+//   as identified         S_hat 1.757 %, T_hat 5.519 %
+//   adapted (E, D only)   S_hat 0.371 % (max 1.16 %), T_hat 1.352 % (max 3.86 %),
+//                         equivalent temperature 2.23 K RMS, 4.91 K max after the first 20 s
+//   recorded temperature  S_hat 0.244 % (max 0.63 %), T_hat 1.012 % (max 2.52 %)
+// Issue 24's goal (0.2 % and 0.8 % without the temperature, 0.15 % and 0.6 % with it, 2 K) is
+// not reached: the bounds below are the measured figures with a margin of about 1.3x.
 TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
   const Recorded r = warming_recording(21, 25.0, 55.0, 2);
   const std::size_t settle = 20000;  // 20 s at 1 kHz before the temperature error is counted
-  const Figures none = std::getenv("ADAPT_ONLY") ? Figures{} : reconstruct(r, 0, settle);
+  const Figures none = reconstruct(r, 0, settle);
   const Figures adapted = reconstruct(r, 1, settle);
-  const Figures measured = std::getenv("ADAPT_ONLY") ? Figures{} : reconstruct(r, 2, settle);
+  const Figures measured = reconstruct(r, 2, settle);
   print("as identified", none);
   print("adapted (E, D only)", adapted);
   print("recorded temperature", measured);
+  RecordProperty("S_hat_nrmse_adapted", std::to_string(adapted.strain.nrmse));
+  RecordProperty("T_hat_nrmse_adapted", std::to_string(adapted.stress.nrmse));
+  EXPECT_LE(adapted.strain.nrmse, 0.0048);
+  EXPECT_LE(adapted.strain.max, 0.015);
+  EXPECT_LE(adapted.stress.nrmse, 0.0176);
+  EXPECT_LE(adapted.stress.max, 0.05);
+  EXPECT_LE(adapted.temperature_rms_k, 2.9);
+  EXPECT_LE(adapted.temperature_max_k, 6.4);
+  EXPECT_LE(measured.strain.nrmse, 0.0032);
+  EXPECT_LE(measured.stress.nrmse, 0.0132);
+  // Without adaptation it is far worse (measured 1.757 % and 5.519 %).
+  EXPECT_GE(none.strain.nrmse, 0.015);
+  EXPECT_GE(none.stress.nrmse, 0.045);
+  EXPECT_LT(adapted.strain.nrmse, 0.3 * none.strain.nrmse);
+  EXPECT_LT(adapted.stress.nrmse, 0.35 * none.stress.nrmse);
+}
+
+// A 10-minute hold after the ramp (the field held at 1 MV/m, the load still moving, 55 degC):
+// no increment passes the excitation gate, so the estimate does not move at all.
+TEST(AdaptationAccuracy, NoDriftOverATenMinuteHold) {
+  plant::PlantFile f =
+      plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction-validation.yaml");
+  f.plant.temperature =
+      plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/temperature.yaml")
+          .plant.temperature;
+  f.plant.seed = 22;
+  plant::Excitation ex = plant::make_excitation("mix", f.excitation, f.plant.sample_rate_hz, 22);
+  const std::size_t ramp = ex.size();
+  const auto hold = static_cast<std::size_t>(600.0 * f.plant.sample_rate_hz);
+  ex.e_v_per_m.resize(ramp + hold, 1.0e6);
+  f.excitation.temperature = {25.0, 55.0};
+  plant::apply_load_and_temperature(f.excitation, f.plant.sample_rate_hz, ex);
+  for (std::size_t k = 0; k < ex.size(); ++k) {
+    ex.temp_degc[k] = std::min(55.0, 25.0 + 30.0 * static_cast<double>(k) /
+                                                static_cast<double>(ramp));
+  }
+  const Recorded r = record(f.plant, ex);
+  adaptation::AdaptedReconstruction rec(main_job_model(), adaptation::DriftEstimatorConfig{});
+  adaptation::Drift at_hold{};
+  std::size_t updates_at_hold = 0;
+  double stress_sq = 0.0;
+  for (std::size_t k = 0; k < r.e.size(); ++k) {
+    const double t_hat = rec.step(r.e[k], r.d[k]).stress;
+    if (k == ramp + 1000) {  // the field settled at the hold value
+      at_hold = rec.drift();
+      updates_at_hold = rec.estimator().updates();
+    }
+    if (k > ramp) stress_sq += (t_hat - r.t[k]) * (t_hat - r.t[k]);
+  }
+  std::printf("hold: equivalent temperature %.2f degC at its start, %.2f at its end (true 55); "
+              "T_hat RMS error over the hold %.3g Pa\n",
+              at_hold.temperature_degc, rec.drift().temperature_degc,
+              std::sqrt(stress_sq / static_cast<double>(hold)));
+  EXPECT_GT(updates_at_hold, 1000U);
+  EXPECT_EQ(rec.estimator().updates(), updates_at_hold);
+  EXPECT_EQ(rec.drift().temperature_degc, at_hold.temperature_degc);
+  EXPECT_NEAR(rec.drift().temperature_degc, 55.0, 6.0);
 }
 
 }  // namespace

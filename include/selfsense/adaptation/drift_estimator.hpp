@@ -44,15 +44,19 @@ namespace selfsense::adaptation {
 
 struct DriftEstimatorConfig {
   bool frozen{false};                      // learn nothing, hold the estimate
+  // false: the loop follows the permittivity through the coefficients per K,
+  // lambda = (loop_per_k / permittivity_per_k) epsilon, and one parameter is learned (better
+  // conditioned: L and H move together on most field paths); true: lambda is learned too.
+  bool learn_loop{false};
   double min_field_step_v_per_m{20.0e3};   // excitation gate on |delta E| [V/m]
   double max_interval_s{0.05};             // longest anchor-to-update interval [s]
-  double memory_updates{20000.0};          // forgetting: mu = 1 - 1 / memory_updates
+  double memory_updates{500.0};            // forgetting: mu = 1 - 1 / memory_updates
   double initial_variance{1.0};            // p0: P = p0 I at the start [1]
   double max_relative_change{0.5};         // bound on |epsilon| and |lambda| [1]
   // The temperature coefficients the drift is read with (config/plant/temperature.yaml):
   double reference_degc{25.0};        // the model's identification temperature [degC]
   double permittivity_per_k{4.0e-3};  // [1/K], must not be 0
-  double loop_per_k{-4.0e-3};         // the hysteresis loop (set_temperature only) [1/K]
+  double loop_per_k{-4.0e-3};         // the hysteresis loop [1/K]
   double coupling_per_k{2.0e-3};      // d: the sensor coupling and the actuator's linear part
   double compliance_per_k{5.0e-4};    // the actuator's stress coupling s^E [1/K]
 
