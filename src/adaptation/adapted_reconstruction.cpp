@@ -17,7 +17,8 @@ models::TransducerModel adaptable(models::TransducerModel model, double sample_t
     throw std::invalid_argument{"adaptation: needs a field-driven model (E in, D sensed)"};
   }
   if (model.vectorial) {
-    throw std::invalid_argument{"adaptation: the stress-dependent (vectorial) model is not adapted"};
+    throw std::invalid_argument{
+        "adaptation: the stress-dependent (vectorial) model is not adapted"};
   }
   if (model.sensed_correction || model.strain_correction) {
     throw std::invalid_argument{"adaptation: a model with diagnosed corrections is not adapted"};
@@ -45,7 +46,8 @@ double linear_weight(const models::SideOperator& side) noexcept {
 }  // namespace
 
 SideSplit::SideSplit(const models::SideOperator& side)
-    : inverse_shape_{operators::DeadZoneSuperposition(side.op().params().superposition).inverse()} {}
+    : inverse_shape_{operators::DeadZoneSuperposition(side.op().params().superposition).inverse()} {
+}
 
 SideSplit::Parts SideSplit::split(const models::SideOperator& side, double field,
                                   double response) const noexcept {
@@ -68,8 +70,8 @@ SideSplit::Parts SideSplit::split(const models::SideOperator& side, double field
 }
 
 AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& model,
-                                             const DriftEstimatorConfig& config,
-                                             double sample_time, double range_margin)
+                                             const DriftEstimatorConfig& config, double sample_time,
+                                             double range_margin)
     : AdaptedReconstruction(adaptable(model, sample_time), config, range_margin, Tag{}) {}
 
 AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& model,
@@ -109,21 +111,18 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::step(double field, double
 AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field, double sensed,
                                                                    bool accepted) noexcept {
   models::SideOperator& s = *kernel_.sensor();
-  const double response_s = s.step_unloaded(field) - s.offset() - s.quadratic() * field * field;
-  const SideSplit::Parts ps = sensor_split_.split(s, field, response_s);
-  const double l_s = ps.linear;
-  const double h_s = ps.loop + s.quadratic() * field * field;
-  estimator_.step(field, sensed, l_s, h_s, accepted);
+  const double fixed_s = s.offset() + s.quadratic() * field * field;  // not scaled by the drift
+  const SideSplit::Parts ps = sensor_split_.split(s, field, s.step_unloaded(field) - fixed_s);
+  estimator_.step(field, sensed - fixed_s, ps.linear, ps.loop, accepted);
   const Drift dr = estimator_.drift();
-  const double unloaded = s.offset() + (1.0 + dr.loop) * h_s + (1.0 + dr.permittivity) * l_s;
+  const double unloaded = fixed_s + (1.0 + dr.permittivity) * ps.linear + (1.0 + dr.loop) * ps.loop;
   Estimate out{(sensed - unloaded) / ((1.0 + dr.coupling) * s.coupling()), kNaN,
                models::SampleStatus::kOk};
   if (kernel_.actuator()) {
     models::SideOperator& a = *kernel_.actuator();
-    const double response_a = a.step_unloaded(field) - a.offset() - a.quadratic() * field * field;
-    const SideSplit::Parts pa = actuator_split_->split(a, field, response_a);
-    out.strain = a.offset() + a.quadratic() * field * field + (1.0 + dr.loop) * pa.loop +
-                 (1.0 + dr.coupling) * pa.linear +
+    const double fixed_a = a.offset() + a.quadratic() * field * field;
+    const SideSplit::Parts pa = actuator_split_->split(a, field, a.step_unloaded(field) - fixed_a);
+    out.strain = fixed_a + (1.0 + dr.coupling) * pa.linear + (1.0 + dr.loop) * pa.loop +
                  (1.0 + dr.compliance) * a.coupling() * out.stress;
   }
   return out;

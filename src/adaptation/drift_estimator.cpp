@@ -45,8 +45,7 @@ bool DriftEstimatorConfig::is_valid(const std::string& prefix, std::string* why)
   return true;
 }
 
-DriftEstimator::DriftEstimator(const DriftEstimatorConfig& config, double sample_time_s,
-                               double c0)
+DriftEstimator::DriftEstimator(const DriftEstimatorConfig& config, double sample_time_s, double c0)
     : config_{config} {
   std::string why;
   if (!config_.is_valid("adaptation.", &why)) throw std::invalid_argument{why};
@@ -65,8 +64,8 @@ DriftEstimator::DriftEstimator(const DriftEstimatorConfig& config, double sample
 
 bool DriftEstimator::step(double field, double sensed, double linear_part, double loop_part,
                           bool accepted) noexcept {
-  if (!accepted || !std::isfinite(field) || !std::isfinite(sensed) ||
-      !std::isfinite(linear_part) || !std::isfinite(loop_part)) {
+  if (!accepted || !std::isfinite(field) || !std::isfinite(sensed) || !std::isfinite(linear_part) ||
+      !std::isfinite(loop_part)) {
     anchored_ = false;
     return false;
   }
@@ -128,8 +127,8 @@ bool DriftEstimator::step(double field, double sensed, double linear_part, doubl
 
 Drift DriftEstimator::drift() const noexcept {
   const double rise = theta_[0] / config_.permittivity_per_k;
-  return Drift{theta_[0], theta_[1], config_.coupling_per_k * rise,
-               config_.compliance_per_k * rise, config_.reference_degc + rise};
+  return Drift{theta_[0], theta_[1], config_.coupling_per_k * rise, config_.compliance_per_k * rise,
+               config_.reference_degc + rise};
 }
 
 void DriftEstimator::set_temperature(double degc) noexcept {

@@ -1,6 +1,8 @@
 // `selfsense simulate` and `selfsense reconstruct` (contracts.md): run a model over a recording
 // and write its outputs beside the recorded columns.
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -13,6 +15,7 @@
 #include "field_signals.hpp"
 #include "model_runs.hpp"
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
+#include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/operators/parameter_error.hpp"
@@ -59,10 +62,11 @@ void run_adapted(const models::TransducerModel& model, const FieldSignals& signa
   rec.set_column("temp_equivalent", std::move(equivalent));
   rec.set_column("permittivity_drift", std::move(permittivity));
   const adaptation::Drift last = adapted.drift();
-  std::printf("adaptation: %zu updates; at the end permittivity %+.3f %%, loop %+.3f %%, "
-              "equivalent temperature %.2f degC%s\n",
-              adapted.estimator().updates(), 100.0 * last.permittivity, 100.0 * last.loop,
-              last.temperature_degc, temperature.empty() ? "" : " (from the recorded temperature)");
+  std::printf(
+      "adaptation: %zu updates; at the end permittivity %+.3f %%, loop %+.3f %%, "
+      "equivalent temperature %.2f degC%s\n",
+      adapted.estimator().updates(), 100.0 * last.permittivity, 100.0 * last.loop,
+      last.temperature_degc, temperature.empty() ? "" : " (from the recorded temperature)");
   std::printf("samples: %s\n", describe(adapted.counts()).c_str());
 }
 
@@ -73,6 +77,34 @@ void report(const ModelRuns& runs, const models::StatusCounts& counts) {
                 operators::format_number(runs.sample_time).c_str());
   }
   std::printf("samples: %s\n", describe(counts).c_str());
+}
+
+// Where the recording holds the reference (a bench or plant recording): the estimates' figures
+// (contracts.md: nrmse and max relative to the reference's range), and the equivalent
+// temperature's error against a recorded temperature.
+void report_figures(const io::Recording& rec, const FieldSignals& signals) {
+  const auto print = [](const char* name, std::span<const double> reference,
+                        std::span<const double> estimate) {
+    const identification::FitQuality q = identification::fit_quality(reference, estimate);
+    std::printf("%s: nrmse %.3f %%, max %.3f %% (against the recorded reference)\n", name,
+                100.0 * q.nrmse, 100.0 * q.max);
+  };
+  if (!signals.stress.empty() && rec.has("T_hat"))
+    print("T_hat", signals.stress, rec.column("T_hat"));
+  if (!signals.s.empty() && rec.has("S_hat")) print("S_hat", signals.s, rec.column("S_hat"));
+  if (rec.has("temp") && rec.has("temp_equivalent")) {
+    const std::span<const double> truth = rec.column("temp");
+    const std::span<const double> eq = rec.column("temp_equivalent");
+    double sq = 0.0;
+    double worst = 0.0;
+    for (std::size_t k = 0; k < truth.size(); ++k) {
+      const double e = eq[k] - truth[k];
+      sq += e * e;
+      worst = std::max(worst, std::abs(e));
+    }
+    std::printf("temp_equivalent: error %.2f K RMS, %.2f K max (against the column temp)\n",
+                std::sqrt(sq / static_cast<double>(std::max<std::size_t>(truth.size(), 1))), worst);
+  }
 }
 
 void run(const RunOptions& opt, bool reconstruct) {
@@ -104,6 +136,7 @@ void run(const RunOptions& opt, bool reconstruct) {
       rec.set_column("estimate_status", runs.estimate_status);
       report(runs, runs.estimate_counts);
     }
+    report_figures(rec, signals);
   } else {
     const ModelRuns runs = run_model(model, signals, true, false);
     const bool field = model.drive() == models::Drive::kField;

@@ -47,8 +47,8 @@ const models::TransducerModel& main_job_model() {
     plant::PlantFile f =
         plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction.yaml");
     f.plant.seed = 1;
-    const Recorded r = record(f.plant, plant::make_excitation("identification", f.excitation,
-                                                              f.plant.sample_rate_hz, 1));
+    const Recorded r = record(
+        f.plant, plant::make_excitation("identification", f.excitation, f.plant.sample_rate_hz, 1));
     return identification::identify(
         {r.e, r.d, r.t, r.s, 1.0 / f.plant.sample_rate_hz}, models::Structure::kPreisachCreep,
         identification::defaults_for(models::Structure::kPreisachCreep));
@@ -117,10 +117,11 @@ Figures reconstruct(const Recorded& r, int kind, std::size_t settle) {
 }
 
 void print(const char* what, const Figures& f) {
-  std::printf("%-22s S_hat %.3f %% (max %.2f %%), T_hat %.3f %% (max %.2f %%), "
-              "equivalent temperature error rms %.2f K max %.2f K\n",
-              what, 100 * f.strain.nrmse, 100 * f.strain.max, 100 * f.stress.nrmse,
-              100 * f.stress.max, f.temperature_rms_k, f.temperature_max_k);
+  std::printf(
+      "%-22s S_hat %.3f %% (max %.2f %%), T_hat %.3f %% (max %.2f %%), "
+      "equivalent temperature error rms %.2f K max %.2f K\n",
+      what, 100 * f.strain.nrmse, 100 * f.strain.max, 100 * f.stress.nrmse, 100 * f.stress.max,
+      f.temperature_rms_k, f.temperature_max_k);
 }
 
 // Measured (seed 21, 25 -> 55 degC over the mix excitation twice, 200 s at 1 kHz):
@@ -172,8 +173,8 @@ TEST(AdaptationAccuracy, NoDriftOverATenMinuteHold) {
   f.excitation.temperature = {25.0, 55.0};
   plant::apply_load_and_temperature(f.excitation, f.plant.sample_rate_hz, ex);
   for (std::size_t k = 0; k < ex.size(); ++k) {
-    ex.temp_degc[k] = std::min(55.0, 25.0 + 30.0 * static_cast<double>(k) /
-                                                static_cast<double>(ramp));
+    ex.temp_degc[k] =
+        std::min(55.0, 25.0 + 30.0 * static_cast<double>(k) / static_cast<double>(ramp));
   }
   const Recorded r = record(f.plant, ex);
   adaptation::AdaptedReconstruction rec(main_job_model(), adaptation::DriftEstimatorConfig{});
@@ -188,10 +189,11 @@ TEST(AdaptationAccuracy, NoDriftOverATenMinuteHold) {
     }
     if (k > ramp) stress_sq += (t_hat - r.t[k]) * (t_hat - r.t[k]);
   }
-  std::printf("hold: equivalent temperature %.2f degC at its start, %.2f at its end (true 55); "
-              "T_hat RMS error over the hold %.3g Pa\n",
-              at_hold.temperature_degc, rec.drift().temperature_degc,
-              std::sqrt(stress_sq / static_cast<double>(hold)));
+  std::printf(
+      "hold: equivalent temperature %.2f degC at its start, %.2f at its end (true 55); "
+      "T_hat RMS error over the hold %.3g Pa\n",
+      at_hold.temperature_degc, rec.drift().temperature_degc,
+      std::sqrt(stress_sq / static_cast<double>(hold)));
   EXPECT_GT(updates_at_hold, 1000U);
   EXPECT_EQ(rec.estimator().updates(), updates_at_hold);
   EXPECT_EQ(rec.drift().temperature_degc, at_hold.temperature_degc);

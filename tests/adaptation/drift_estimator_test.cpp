@@ -1,6 +1,8 @@
 // The drift estimator and the adapted reconstruction on synthetic data whose drift is known:
 // convergence, the gates (holds, rejected samples, frozen), the bounds, saved state, and the
 // real-time path (no allocation, no lock).
+#include "selfsense/adaptation/drift_estimator.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,7 +13,6 @@
 #include <vector>
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
-#include "selfsense/adaptation/drift_estimator.hpp"
 #include "support/allocation_counter.hpp"
 #include "support/transducer_data.hpp"
 
@@ -30,8 +31,7 @@ struct Drifted {
   std::vector<double> e, d, t;
 };
 
-Drifted drifted(double epsilon, double lambda, double coupling, std::size_t n,
-                std::uint64_t seed) {
+Drifted drifted(double epsilon, double lambda, double coupling, std::size_t n, std::uint64_t seed) {
   Drifted out{test::typical_transducer(kTs), {}, {}, {}};
   const models::SideModel& sensor = *out.model.sensor;
   models::SideOperator truth(sensor);

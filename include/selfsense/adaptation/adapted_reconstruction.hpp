@@ -4,14 +4,14 @@
 // (vectorial) model is refused by name.
 //
 // With epsilon, lambda the estimated changes of permittivity and loop, c = coupling_per_k
-// (theta_eq - reference) and s = compliance_per_k (theta_eq - reference) (units and symbols of
-// drift_estimator.hpp; per side y0 the offset, c0 the linear weight, r = G[E] + y0 the
-// operator's response, H = r - y0 - c0 E):
-//   T_hat = (D - y0_s - (1 + lambda) H_s - (1 + epsilon) c0_s E) / ((1 + c) d_s)       [Pa]
-//   S_hat = y0_a + (1 + lambda) H_a + (1 + c) c0_a E + (1 + s) s_a T_hat               [-]
+// (theta_eq - reference) and s = compliance_per_k (theta_eq - reference) (drift_estimator.hpp),
+// per side y0 the offset, q the quadratic term and L, H the split of the operator's response
+// (SideSplit below):
+//   T_hat = (D - y0_s - q_s E^2 - (1 + epsilon) L_s - (1 + lambda) H_s) / ((1 + c) d_s)    [Pa]
+//   S_hat = y0_a + q_a E^2 + (1 + c) L_a + (1 + lambda) H_a + (1 + s) s_a T_hat            [-]
 // The plant's loop scale acts on both sides alike (so lambda is the actuator's too); the
 // coupling d cannot be told from the stress by E and D, so it follows the equivalent temperature
-// with its coefficient per K.
+// with its coefficient per K, and so does the actuator's linear part (d E).
 //
 // A sample whose inputs are not finite or outside the identification range (widened by
 // range_margin of its span) is rejected as models::Reconstruction rejects it: the operators

@@ -4,15 +4,19 @@
 // forgetting on field increments, and the equivalent temperature that the permittivity change
 // means.
 //
-// Measurement model (field drive; the model's sensor side split into its linear capacitive
-// part c0 E and the rest H = G_s[E] - y0 - c0 E, c0 the PI's linear weight times the
-// superposition's; the stress coupling d):
-//   D = y0 + (1 + lambda) H + (1 + epsilon) c0 E + d' T
+// Measurement model (field drive; the model's sensor response split into its linear capacitive
+// part L and the loop H, adapted_reconstruction.hpp's SideSplit; the stress coupling d):
+//   D = y0 + (1 + epsilon) L + (1 + lambda) H + d' T                                [C/m^2]
 // Between an anchor sample a and the present sample k (delta x = x[k] - x[a]):
-//   z = delta D - delta H - c0 delta E = [c0 delta E, delta H] . [epsilon, lambda] + d' delta T
+//   z = delta D - delta L - delta H = epsilon delta L + lambda delta H + d' delta T
 // The stress is unknown, but it moves slowly against the field over the short interval between
 // anchor and update, so d' delta T is noise; a constant stress, a charge offset and a slow
 // charge drift cancel in the increments.
+//
+// Parameters: with learn_loop false (default) one, epsilon, and the loop tied to it through the
+// coefficients per K, lambda = (loop_per_k / permittivity_per_k) epsilon, so
+//   phi = delta L + (loop_per_k / permittivity_per_k) delta H;
+// with learn_loop two, phi = [delta L, delta H], theta = [epsilon, lambda].
 //
 // Gates (excitation): an update happens only when |delta E| >= min_field_step_v_per_m within
 // max_interval_s of the anchor; then the anchor moves to k. An anchor older than
@@ -22,14 +26,14 @@
 // holds.
 //
 // RLS with forgetting factor mu = 1 - 1 / memory_updates, applied only on updates (no
-// covariance wind-up on holds); regressors and residual divided by the model's sensed span
-// (below):
+// covariance wind-up on holds):
 //   K = P phi / (mu + phi' P phi),   theta += K (z - phi' theta),   P = (P - K phi' P) / mu
-// then theta is clamped to +-max_relative_change and P is scaled back to trace <= 2 p0.
-// Regressors and residual are divided by c0 min_field_step_v_per_m (a smallest update's
-// capacitive increment), so they are dimensionless and about 1.
+// then theta is clamped to +-max_relative_change and P scaled back to trace <= p0 per
+// parameter. phi and z are divided by c0 min_field_step_v_per_m (a smallest update's capacitive
+// increment, c0 the model's linear weight), so they are dimensionless and about 1.
 //
-// Equivalent temperature: theta_eq = reference_degc + epsilon / permittivity_per_k [degC].
+// Equivalent temperature: theta_eq = reference_degc + epsilon / permittivity_per_k [degC]; the
+// coupling and compliance follow it: d' = (1 + coupling_per_k (theta_eq - reference)) d.
 //
 // Real-time safe after construction: step(), save_state(), restore_state() are noexcept and
 // allocate nothing.
@@ -43,16 +47,16 @@
 namespace selfsense::adaptation {
 
 struct DriftEstimatorConfig {
-  bool frozen{false};                      // learn nothing, hold the estimate
+  bool frozen{false};  // learn nothing, hold the estimate
   // false: the loop follows the permittivity through the coefficients per K,
   // lambda = (loop_per_k / permittivity_per_k) epsilon, and one parameter is learned (better
   // conditioned: L and H move together on most field paths); true: lambda is learned too.
   bool learn_loop{false};
-  double min_field_step_v_per_m{20.0e3};   // excitation gate on |delta E| [V/m]
-  double max_interval_s{0.05};             // longest anchor-to-update interval [s]
-  double memory_updates{500.0};            // forgetting: mu = 1 - 1 / memory_updates
-  double initial_variance{1.0};            // p0: P = p0 I at the start [1]
-  double max_relative_change{0.5};         // bound on |epsilon| and |lambda| [1]
+  double min_field_step_v_per_m{20.0e3};  // excitation gate on |delta E| [V/m]
+  double max_interval_s{0.05};            // longest anchor-to-update interval [s]
+  double memory_updates{500.0};           // forgetting: mu = 1 - 1 / memory_updates
+  double initial_variance{1.0};           // p0: P = p0 I at the start [1]
+  double max_relative_change{0.5};        // bound on |epsilon| and |lambda| [1]
   // The temperature coefficients the drift is read with (config/plant/temperature.yaml):
   double reference_degc{25.0};        // the model's identification temperature [degC]
   double permittivity_per_k{4.0e-3};  // [1/K], must not be 0
