@@ -61,12 +61,9 @@ SideSplit::Parts SideSplit::split(const models::SideOperator& side, double field
       creep += p.creep.weights[j] * state[lags + j];
   }
   const double linear_in = p.hysteresis.linear_weight * field + creep;
-  const double y_in = inverse_shape_.evaluate(response);
-  const double scale = std::abs(y_in) > 1e-12 * (std::abs(response) + 1e-300)
-                           ? response / y_in
-                           : p.superposition.linear_weight;
-  const double linear = scale * linear_in;
-  return {linear, response - linear};
+  const double loop =
+      p.superposition.linear_weight * (inverse_shape_.evaluate(response) - linear_in);
+  return {response - loop, loop};
 }
 
 AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& model,

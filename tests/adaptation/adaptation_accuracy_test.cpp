@@ -125,10 +125,10 @@ void print(const char* what, const Figures& f) {
 }
 
 // Measured (seed 21, 25 -> 55 degC over the mix excitation twice, 200 s at 1 kHz):
-//   as identified         S_hat 1.757 %, T_hat 5.519 %
-//   adapted (E, D only)   S_hat 0.371 % (max 1.16 %), T_hat 1.352 % (max 3.86 %),
-//                         equivalent temperature 2.23 K RMS, 4.91 K max after the first 20 s
-//   recorded temperature  S_hat 0.244 % (max 0.63 %), T_hat 1.012 % (max 2.52 %)
+//   as identified         S_hat 1.757 % (max 6.16 %), T_hat 5.519 % (max 19.39 %)
+//   adapted (E, D only)   S_hat 0.309 % (max 1.08 %), T_hat 1.120 % (max 3.54 %),
+//                         equivalent temperature 2.66 K RMS, 5.72 K max after the first 20 s
+//   recorded temperature  S_hat 0.165 % (max 0.63 %), T_hat 0.709 % (max 2.50 %)
 // Issue 24's goal (0.2 % and 0.8 % without the temperature, 0.15 % and 0.6 % with it, 2 K) is
 // not reached: the bounds below are the measured figures with a margin of about 1.3x.
 TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
@@ -142,23 +142,27 @@ TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
   print("recorded temperature", measured);
   RecordProperty("S_hat_nrmse_adapted", std::to_string(adapted.strain.nrmse));
   RecordProperty("T_hat_nrmse_adapted", std::to_string(adapted.stress.nrmse));
-  EXPECT_LE(adapted.strain.nrmse, 0.0048);
-  EXPECT_LE(adapted.strain.max, 0.015);
-  EXPECT_LE(adapted.stress.nrmse, 0.0176);
-  EXPECT_LE(adapted.stress.max, 0.05);
-  EXPECT_LE(adapted.temperature_rms_k, 2.9);
-  EXPECT_LE(adapted.temperature_max_k, 6.4);
-  EXPECT_LE(measured.strain.nrmse, 0.0032);
-  EXPECT_LE(measured.stress.nrmse, 0.0132);
+  EXPECT_LE(adapted.strain.nrmse, 0.0040);
+  EXPECT_LE(adapted.strain.max, 0.014);
+  EXPECT_LE(adapted.stress.nrmse, 0.0146);
+  EXPECT_LE(adapted.stress.max, 0.046);
+  EXPECT_LE(adapted.temperature_rms_k, 3.5);
+  EXPECT_LE(adapted.temperature_max_k, 7.4);
+  EXPECT_LE(measured.strain.nrmse, 0.0021);
+  EXPECT_LE(measured.strain.max, 0.0082);
+  EXPECT_LE(measured.stress.nrmse, 0.0092);
+  EXPECT_LE(measured.stress.max, 0.0325);
   // Without adaptation it is far worse (measured 1.757 % and 5.519 %).
   EXPECT_GE(none.strain.nrmse, 0.015);
   EXPECT_GE(none.stress.nrmse, 0.045);
-  EXPECT_LT(adapted.strain.nrmse, 0.3 * none.strain.nrmse);
-  EXPECT_LT(adapted.stress.nrmse, 0.35 * none.stress.nrmse);
+  EXPECT_LT(adapted.strain.nrmse, 0.25 * none.strain.nrmse);
+  EXPECT_LT(adapted.stress.nrmse, 0.25 * none.stress.nrmse);
 }
 
 // A 10-minute hold after the ramp (the field held at 1 MV/m, the load still moving, 55 degC):
-// no increment passes the excitation gate, so the estimate does not move at all.
+// no increment passes the excitation gate, so the estimate does not move at all. Measured: 51.68
+// degC at the hold (the estimate lags a 30 K ramp over 100 s by 3.3 K), T_hat RMS error over
+// the hold 3.9e5 Pa.
 TEST(AdaptationAccuracy, NoDriftOverATenMinuteHold) {
   plant::PlantFile f =
       plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction-validation.yaml");
@@ -197,7 +201,7 @@ TEST(AdaptationAccuracy, NoDriftOverATenMinuteHold) {
   EXPECT_GT(updates_at_hold, 1000U);
   EXPECT_EQ(rec.estimator().updates(), updates_at_hold);
   EXPECT_EQ(rec.drift().temperature_degc, at_hold.temperature_degc);
-  EXPECT_NEAR(rec.drift().temperature_degc, 55.0, 6.0);
+  EXPECT_NEAR(rec.drift().temperature_degc, 55.0, 4.5);
 }
 
 }  // namespace
