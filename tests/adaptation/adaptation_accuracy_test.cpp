@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
+#include <random>
 #include <vector>
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
@@ -57,8 +59,10 @@ const models::TransducerModel& main_job_model() {
 }
 
 // The validation plant with config/plant/temperature.yaml's coefficients, the mix excitation
-// repeated `repeats` times, the temperature ramping start -> end over the whole recording.
-Recorded warming_recording(std::uint64_t seed, double start_degc, double end_degc, int repeats) {
+// repeated `repeats` times, the temperature ramping start -> end over the whole recording (or
+// swinging, below).
+Recorded warming_recording(std::uint64_t seed, double start_degc, double end_degc, int repeats,
+                           bool swings = false) {
   plant::PlantFile f =
       plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction-validation.yaml");
   const plant::PlantFile heat =
@@ -72,6 +76,23 @@ Recorded warming_recording(std::uint64_t seed, double start_degc, double end_deg
   }
   f.excitation.temperature = {start_degc, end_degc};
   plant::apply_load_and_temperature(f.excitation, f.plant.sample_rate_hz, ex);
+  if (swings) {
+    // Slow random swings: up from 25 to 40 degC over 30 s, then three slow sines of random
+    // phase (periods 150, 67 and 41 s; 6, 5 and 3 K) about 40 degC.
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> phase(0.0, 2.0 * std::numbers::pi);
+    const double p1 = phase(rng);
+    const double p2 = phase(rng);
+    const double p3 = phase(rng);
+    const double w = 2.0 * std::numbers::pi;
+    for (std::size_t k = 0; k < ex.size(); ++k) {
+      const double t = static_cast<double>(k) / f.plant.sample_rate_hz;
+      const double rise = std::min(1.0, t / 30.0);
+      const double swing = 6.0 * std::sin(w * t / 150.0 + p1) + 5.0 * std::sin(w * t / 67.0 + p2) +
+                           3.0 * std::sin(w * t / 41.0 + p3);
+      ex.temp_degc[k] = 25.0 + rise * (15.0 + swing);
+    }
+  }
   return record(f.plant, ex);
 }
 
@@ -157,6 +178,32 @@ TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
   EXPECT_GE(none.stress.nrmse, 0.045);
   EXPECT_LT(adapted.strain.nrmse, 0.25 * none.strain.nrmse);
   EXPECT_LT(adapted.stress.nrmse, 0.25 * none.stress.nrmse);
+}
+
+// Slow random swings about 40 degC (between about 26 and 54 degC, up to 0.5 K/s), the same
+// model and validation plant, 300 s (seed 23). Measured:
+//   as identified         S_hat 1.560 % (max 4.85 %), T_hat 4.942 % (max 16.03 %)
+//   adapted (E, D only)   S_hat 0.403 % (max 1.47 %), T_hat 1.383 % (max 4.75 %),
+//                         equivalent temperature 3.84 K RMS, 10.93 K max after the first 20 s
+//   recorded temperature  S_hat 0.142 % (max 0.61 %), T_hat 0.638 % (max 2.47 %)
+// Asserted at about 1.3x; the goal is not reached without the temperature (docs/adaptation.md).
+TEST(AdaptationAccuracy, SlowRandomSwingsWithoutTemperatureInput) {
+  const Recorded r = warming_recording(23, 25.0, 25.0, 3, true);
+  const std::size_t settle = 20000;
+  const Figures none = reconstruct(r, 0, settle);
+  const Figures adapted = reconstruct(r, 1, settle);
+  const Figures measured = reconstruct(r, 2, settle);
+  print("swings, as identified", none);
+  print("swings, adapted", adapted);
+  print("swings, recorded temp", measured);
+  EXPECT_LE(adapted.strain.nrmse, 0.0053);
+  EXPECT_LE(adapted.stress.nrmse, 0.018);
+  EXPECT_LE(adapted.temperature_rms_k, 5.0);
+  EXPECT_LE(measured.strain.nrmse, 0.0019);
+  EXPECT_LE(measured.stress.nrmse, 0.0083);
+  EXPECT_GE(none.stress.nrmse, 0.04);
+  EXPECT_LT(adapted.strain.nrmse, 0.35 * none.strain.nrmse);
+  EXPECT_LT(adapted.stress.nrmse, 0.35 * none.stress.nrmse);
 }
 
 // A 10-minute hold after the ramp (the field held at 1 MV/m, the load still moving, 55 degC):
