@@ -4,6 +4,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace selfsense::adaptation {
 
@@ -80,6 +81,7 @@ AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& mode
       gate_(model.drive_range, model.sensed_range, range_margin),
       last_{0.0, kNaN, models::SampleStatus::kOk} {
   if (kernel_.actuator()) actuator_split_.emplace(*kernel_.actuator());
+  identity_ = {model.structure, models::parameter_hash(model), state_size()};
   if (!(range_margin >= 0.0)) {
     throw std::invalid_argument{"adaptation: range_margin must be >= 0"};
   }
@@ -141,6 +143,28 @@ bool AdaptedReconstruction::restore_state(std::span<const double> in) noexcept {
   kernel_.restore_state(in.first(kernel_.state_size()));
   estimator_.restore_state(in.subspan(kernel_.state_size()));
   return true;
+}
+
+models::SavedState AdaptedReconstruction::make_saved_state() const {
+  return {identity_, std::vector<double>(identity_.state_size, 0.0)};
+}
+
+bool AdaptedReconstruction::save_state(models::SavedState& out) const noexcept {
+  if (out.values.size() != identity_.state_size) return false;
+  out.identity = identity_;
+  return save_state(std::span<double>(out.values));
+}
+
+models::RestoreResult AdaptedReconstruction::restore_state(const models::SavedState& in) noexcept {
+  if (in.identity.structure != identity_.structure ||
+      in.identity.parameter_hash != identity_.parameter_hash) {
+    return models::RestoreResult::kWrongModel;
+  }
+  if (in.identity.state_size != identity_.state_size || in.values.size() != identity_.state_size) {
+    return models::RestoreResult::kWrongSize;
+  }
+  restore_state(std::span<const double>(in.values));
+  return models::RestoreResult::kOk;
 }
 
 }  // namespace selfsense::adaptation

@@ -190,6 +190,33 @@ TEST(AdaptedReconstruction, SavedStateResumesExactly) {
   EXPECT_EQ(a.estimator().updates(), b.estimator().updates());
 }
 
+// A restart resumes the learned drift only into the same model: a state of another model or a
+// plain Reconstruction's state of this one is refused and changes nothing.
+TEST(AdaptedReconstruction, SavedStateCarriesTheModelsIdentity) {
+  const Drifted data = drifted(0.05, -0.05, 0.025, 40000, 7);
+  AdaptedReconstruction a(data.model, DriftEstimatorConfig{});
+  for (std::size_t k = 0; k < data.e.size(); ++k)
+    a.step(data.e[k], data.d[k]);
+  models::SavedState saved = a.make_saved_state();
+  ASSERT_TRUE(a.save_state(saved));
+  AdaptedReconstruction b(data.model, DriftEstimatorConfig{});
+  EXPECT_EQ(b.restore_state(saved), models::RestoreResult::kOk);
+  EXPECT_EQ(b.drift().temperature_degc, a.drift().temperature_degc);
+  EXPECT_GT(b.drift().temperature_degc, 30.0);
+
+  models::TransducerModel other = data.model;
+  other.sensor->offset += 1e-4;
+  AdaptedReconstruction c(other, DriftEstimatorConfig{});
+  EXPECT_EQ(c.restore_state(saved), models::RestoreResult::kWrongModel);
+  EXPECT_EQ(c.drift().temperature_degc, 25.0);
+
+  const models::Reconstruction plain(data.model);
+  EXPECT_EQ(b.restore_state(plain.make_saved_state()), models::RestoreResult::kWrongSize);
+  models::SavedState wrong = b.make_saved_state();
+  wrong.values.pop_back();
+  EXPECT_FALSE(b.save_state(wrong));
+}
+
 TEST(AdaptedReconstruction, RejectsSpikesAndLearnsNothingFromThem) {
   const Drifted data = drifted(0.05, -0.03, 0.02, 20000, 5);
   AdaptedReconstruction rec(data.model, DriftEstimatorConfig{});
@@ -222,6 +249,7 @@ TEST(AdaptationRealTime, StepsAndStateSavesDoNotAllocateOrLock) {
   models::Reconstructor plain(data.model);
   const SideSplit split(*plain.sensor());
   std::vector<double> state(rec.state_size());
+  models::SavedState saved = rec.make_saved_state();
   std::vector<double> est_state(DriftEstimator::state_size());
   double sink = 0.0;
   test::AllocationCounter counter;
@@ -229,6 +257,8 @@ TEST(AdaptationRealTime, StepsAndStateSavesDoNotAllocateOrLock) {
     const AdaptedReconstruction::Estimate out = rec.step(data.e[k], data.d[k]);
     rec.save_state(state);
     rec.restore_state(state);
+    rec.save_state(saved);
+    sink += static_cast<double>(rec.restore_state(saved));
     est.step(data.e[k], data.d[k], 2e-8 * data.e[k], 0.0, k % 7 != 0);
     sink += split.split(*plain.sensor(), data.e[k], plain.sensor()->step_unloaded(data.e[k])).loop;
     est.save_state(est_state);

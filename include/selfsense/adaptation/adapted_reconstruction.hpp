@@ -26,6 +26,7 @@
 #include <span>
 
 #include "selfsense/adaptation/drift_estimator.hpp"
+#include "selfsense/models/model_identity.hpp"
 #include "selfsense/models/reconstructor.hpp"
 #include "selfsense/models/runtime_model.hpp"
 #include "selfsense/models/sample_status.hpp"
@@ -88,6 +89,13 @@ class AdaptedReconstruction final {
   // False (nothing written or read) if the span's size is not state_size().
   bool save_state(std::span<double> out) const noexcept;
   bool restore_state(std::span<const double> in) noexcept;
+  // With the model's identity (models/model_identity.hpp: its structure and parameter hash,
+  // and this state's size, so a plain Reconstruction's state of the same model is refused as
+  // kWrongSize): a restart resumes the learned drift only into the same model.
+  [[nodiscard]] const models::ModelIdentity& identity() const noexcept { return identity_; }
+  [[nodiscard]] models::SavedState make_saved_state() const;  // allocates
+  bool save_state(models::SavedState& out) const noexcept;
+  models::RestoreResult restore_state(const models::SavedState& in) noexcept;
 
  private:
   struct Tag {};
@@ -103,6 +111,7 @@ class AdaptedReconstruction final {
   models::detail::HeldInputs held_{};
   Estimate last_{};
   models::StatusCounts counts_{};
+  models::ModelIdentity identity_{};
 };
 
 }  // namespace selfsense::adaptation
