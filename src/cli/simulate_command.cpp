@@ -1,14 +1,21 @@
 // `selfsense simulate` and `selfsense reconstruct` (contracts.md): run a model over a recording
 // and write its outputs beside the recorded columns.
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "commands.hpp"
 #include "field_signals.hpp"
 #include "model_runs.hpp"
+#include "selfsense/adaptation/adapted_reconstruction.hpp"
+#include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/operators/parameter_error.hpp"
@@ -20,7 +27,48 @@ struct RunOptions {
   std::filesystem::path model{};
   std::filesystem::path recording{};
   std::filesystem::path out{};
+  bool adapt{false};                 // reconstruct: estimate the drift online (docs/adaptation.md)
+  std::string temperature_column{};  // reconstruct: the recorded temperature [degC] to use
 };
+
+// `reconstruct --adapt`: the adapted reconstruction over the recording, with the equivalent
+// temperature (temp_equivalent [degC]) and the permittivity drift (permittivity_drift [1])
+// beside T_hat and S_hat. With a temperature column the drift follows that temperature instead.
+void run_adapted(const models::TransducerModel& model, const FieldSignals& signals,
+                 const std::vector<double>& temperature, io::Recording& rec) {
+  adaptation::DriftEstimatorConfig config{};
+  config.frozen = !temperature.empty();
+  adaptation::AdaptedReconstruction adapted(model, config, signals.sample_time);
+  const std::span<const double> x = signals.drive(model.drive());
+  const std::span<const double> y = signals.sensed(model.drive());
+  const std::size_t n = signals.size();
+  std::vector<double> t_hat(n);
+  std::vector<double> s_hat(adapted.has_strain() ? n : 0);
+  std::vector<double> status(n);
+  std::vector<double> equivalent(n);
+  std::vector<double> permittivity(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!temperature.empty()) adapted.set_temperature(temperature[k]);
+    const adaptation::AdaptedReconstruction::Estimate est = adapted.step(x[k], y[k]);
+    t_hat[k] = est.stress;
+    if (!s_hat.empty()) s_hat[k] = est.strain;
+    status[k] = static_cast<double>(est.status);
+    equivalent[k] = adapted.drift().temperature_degc;
+    permittivity[k] = adapted.drift().permittivity;
+  }
+  rec.set_column("T_hat", std::move(t_hat));
+  if (!s_hat.empty()) rec.set_column("S_hat", std::move(s_hat));
+  rec.set_column("estimate_status", std::move(status));
+  rec.set_column("temp_equivalent", std::move(equivalent));
+  rec.set_column("permittivity_drift", std::move(permittivity));
+  const adaptation::Drift last = adapted.drift();
+  std::printf(
+      "adaptation: %zu updates; at the end permittivity %+.3f %%, loop %+.3f %%, "
+      "equivalent temperature %.2f degC%s\n",
+      adapted.estimator().updates(), 100.0 * last.permittivity, 100.0 * last.loop,
+      last.temperature_degc, temperature.empty() ? "" : " (from the recorded temperature)");
+  std::printf("samples: %s\n", describe(adapted.counts()).c_str());
+}
 
 // Says what a user must know about the run: the rate it ran at and every rejected sample.
 void report(const ModelRuns& runs, const models::StatusCounts& counts) {
@@ -31,11 +79,44 @@ void report(const ModelRuns& runs, const models::StatusCounts& counts) {
   std::printf("samples: %s\n", describe(counts).c_str());
 }
 
+// Where the recording holds the reference (a bench or plant recording): the estimates' figures
+// (contracts.md: nrmse and max relative to the reference's range), and the equivalent
+// temperature's error against a recorded temperature.
+void report_figures(const io::Recording& rec, const FieldSignals& signals) {
+  const auto print = [](const char* name, std::span<const double> reference,
+                        std::span<const double> estimate) {
+    const identification::FitQuality q = identification::fit_quality(reference, estimate);
+    std::printf("%s: nrmse %.3f %%, max %.3f %% (against the recorded reference)\n", name,
+                100.0 * q.nrmse, 100.0 * q.max);
+  };
+  if (!signals.stress.empty() && rec.has("T_hat"))
+    print("T_hat", signals.stress, rec.column("T_hat"));
+  if (!signals.s.empty() && rec.has("S_hat")) print("S_hat", signals.s, rec.column("S_hat"));
+  if (rec.has("temp") && rec.has("temp_equivalent")) {
+    const std::span<const double> truth = rec.column("temp");
+    const std::span<const double> eq = rec.column("temp_equivalent");
+    double sq = 0.0;
+    double worst = 0.0;
+    for (std::size_t k = 0; k < truth.size(); ++k) {
+      const double e = eq[k] - truth[k];
+      sq += e * e;
+      worst = std::max(worst, std::abs(e));
+    }
+    std::printf("temp_equivalent: error %.2f K RMS, %.2f K max (against the column temp)\n",
+                std::sqrt(sq / static_cast<double>(std::max<std::size_t>(truth.size(), 1))), worst);
+  }
+}
+
 void run(const RunOptions& opt, bool reconstruct) {
   const models::TransducerModel model = models::load_model(opt.model);
   io::Recording rec = io::read_recording_csv(opt.recording, io::ReadOptions{{"t"}});
-  const FieldSignals signals =
-      field_signals(rec, opt.recording.string(), model.geometry, model.drive());
+  FieldSignals signals = field_signals(rec, opt.recording.string(), model.geometry, model.drive());
+  std::vector<double> temperature{};
+  if (!opt.temperature_column.empty()) {
+    const std::span<const double> column = rec.column(opt.temperature_column);
+    temperature.assign(column.begin(), column.end());
+    signals.temp = temperature;
+  }
   if (reconstruct) {
     if (signals.sensed(model.drive()).empty()) {
       throw io::RecordingError(signals.source + ": reconstruction needs the sensed channel (" +
@@ -46,11 +127,16 @@ void run(const RunOptions& opt, bool reconstruct) {
                                ": the model cannot reconstruct stress (no sensor side with a "
                                "stress coupling: identify it from a recording with T or F)");
     }
-    const ModelRuns runs = run_model(model, signals, false, true);
-    rec.set_column("T_hat", runs.stress_hat);
-    if (!runs.strain_hat.empty()) rec.set_column("S_hat", runs.strain_hat);
-    rec.set_column("estimate_status", runs.estimate_status);
-    report(runs, runs.estimate_counts);
+    if (opt.adapt) {
+      run_adapted(model, signals, temperature, rec);
+    } else {
+      const ModelRuns runs = run_model(model, signals, false, true);
+      rec.set_column("T_hat", runs.stress_hat);
+      if (!runs.strain_hat.empty()) rec.set_column("S_hat", runs.strain_hat);
+      rec.set_column("estimate_status", runs.estimate_status);
+      report(runs, runs.estimate_counts);
+    }
+    report_figures(rec, signals);
   } else {
     const ModelRuns runs = run_model(model, signals, true, false);
     const bool field = model.drive() == models::Drive::kField;
@@ -60,7 +146,7 @@ void run(const RunOptions& opt, bool reconstruct) {
     report(runs, runs.forward_counts);
   }
   rec.comments.push_back(std::string("selfsense ") + (reconstruct ? "reconstruct" : "simulate") +
-                         " with model " + opt.model.string());
+                         (opt.adapt ? " --adapt" : "") + " with model " + opt.model.string());
   io::write_recording_csv(rec, opt.out);
   std::printf("wrote %s (%zu samples)\n", opt.out.string().c_str(), rec.rows());
 }
@@ -73,6 +159,14 @@ void add(CLI::App& app, const char* name, const char* help, bool reconstruct) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", opt->out, "Output recording (CSV)")->required();
+  if (reconstruct) {
+    cmd->add_flag("--adapt", opt->adapt,
+                  "Estimate the sensor side's drift online from E and D (docs/adaptation.md); "
+                  "writes temp_equivalent and permittivity_drift too");
+    cmd->add_option("--temperature-column", opt->temperature_column,
+                    "Recorded temperature column [degC]: with --adapt the drift follows it, "
+                    "without it feeds the model's temperature corrections");
+  }
   cmd->callback([opt, reconstruct] { run(*opt, reconstruct); });
 }
 

@@ -36,6 +36,20 @@ has_column "$work/sim.csv" D_model || fail "simulate wrote no D_model"
 has_column "$work/sim.csv" S_model || fail "simulate wrote no S_model"
 "$bin" reconstruct --model "$work/m.yaml" --recording "$work/r.csv" --out "$work/rec.csv" >/dev/null
 has_column "$work/rec.csv" T_hat || fail "reconstruct wrote no T_hat"
+# --adapt (docs/adaptation.md): on a recording at the identification temperature the drift
+# estimate learns from the moving field and stays near 25 degC; a missing temperature column
+# is named.
+"$bin" reconstruct --model "$work/m.yaml" --recording "$work/r.csv" --adapt --out "$work/ad.csv" >"$work/ad.txt"
+has_column "$work/ad.csv" temp_equivalent || fail "reconstruct --adapt wrote no temp_equivalent"
+has_column "$work/ad.csv" S_hat || fail "reconstruct --adapt wrote no S_hat"
+eq=$(sed -n 's/^adaptation: \([0-9]*\) updates;.*equivalent temperature \([0-9.-]*\) degC.*/\1 \2/p' "$work/ad.txt")
+awk -v u="${eq%% *}" -v t="${eq##* }" 'BEGIN { exit !(u > 100 && t > 24 && t < 26) }' ||
+  fail "reconstruct --adapt: updates and equivalent temperature '$eq'"
+if "$bin" reconstruct --model "$work/m.yaml" --recording "$work/r.csv" --adapt \
+  --temperature-column nope --out "$work/x.csv" 2>"$work/err.txt"; then
+  fail "a missing temperature column was accepted"
+fi
+grep -q "no column 'nope'" "$work/err.txt" || fail "missing temperature column not named: $(cat "$work/err.txt")"
 
 # preisach-creep: the identification excitation (mix, then minor loops), sizes chosen on the
 # fitting data and said, hinges in the model file, the model runs in reconstruct.
@@ -64,6 +78,10 @@ grep -q 'no T: free actuator' "$work/free.txt" || fail "identify did not say T i
 grep -q '^vectorial:' "$work/v.yaml" || fail "stress-hysteresis model has no vectorial section"
 "$bin" reconstruct --model "$work/v.yaml" --recording "$work/r.csv" --out "$work/vrec.csv" 2>/dev/null
 has_column "$work/vrec.csv" T_hat || fail "vectorial reconstruct wrote no T_hat"
+if "$bin" reconstruct --model "$work/v.yaml" --recording "$work/r.csv" --adapt --out "$work/x.csv" 2>"$work/err.txt"; then
+  fail "reconstruct --adapt accepted the stress-dependent model"
+fi
+grep -q "stress-dependent" "$work/err.txt" || fail "--adapt refusal not explained: $(cat "$work/err.txt")"
 
 # The paced plant (the daemon's simulated backend): real time at 1 kHz, overruns reported.
 printf 'plant:\n  sample_rate_hz: 1000\nexcitation:\n  steps: {levels_v_per_m: [1.0e6, 0.0], hold_s: 0.1}\n' >"$work/paced.yaml"

@@ -14,6 +14,7 @@ cd "$root"
 declare -A allowed=(
   [operators]="operators"
   [models]="models operators"
+  [adaptation]="adaptation models operators"
   [control]="control"
   [plant]="plant"
   [identification]="identification models operators"
@@ -25,7 +26,7 @@ declare -A allowed=(
   [daemon]="daemon runtime models operators control io model_io"
 )
 # The math: no files, streams, threads, clocks, sockets or file formats.
-math="operators models control plant identification diagnosis"
+math="operators models adaptation control plant identification diagnosis"
 forbidden_system='fstream|iostream|filesystem|thread|mutex|condition_variable|future|chrono|cstdio|yaml-cpp/.*|nlohmann/.*|sys/.*|unistd\.h|fcntl\.h|pthread\.h'
 
 violations=0

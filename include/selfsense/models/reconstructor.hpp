@@ -24,6 +24,8 @@ class SideOperator final {
   // G[x] + y0 + quadratic x^2 (advances the operator).
   double step_unloaded(double x) noexcept { return op_.step(x) + offset_ + quadratic_ * x * x; }
   [[nodiscard]] double coupling() const noexcept { return coupling_; }
+  [[nodiscard]] double offset() const noexcept { return offset_; }  // y0
+  [[nodiscard]] double quadratic() const noexcept { return quadratic_; }
   [[nodiscard]] const operators::HysteresisCreep& op() const noexcept { return op_; }
   [[nodiscard]] operators::HysteresisCreep& op() noexcept { return op_; }
 

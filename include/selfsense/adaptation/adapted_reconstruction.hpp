@@ -1,0 +1,117 @@
+// Self-sensing with the drift of the sensor side estimated online (drift_estimator.hpp): the
+// affine reconstruction (models/reconstructor.hpp) with its parameters scaled by the estimate,
+// sample by sample. Field drive only; a model with diagnosed corrections or a stress-dependent
+// (vectorial) model is refused by name.
+//
+// With epsilon, lambda the estimated changes of permittivity and loop, c = coupling_per_k
+// (theta_eq - reference) and s = compliance_per_k (theta_eq - reference) (drift_estimator.hpp),
+// per side y0 the offset, q the quadratic term and L, H the split of the operator's response
+// (SideSplit below):
+//   T_hat = (D - y0_s - q_s E^2 - (1 + epsilon) L_s - (1 + lambda) H_s) / ((1 + c) d_s)    [Pa]
+//   S_hat = y0_a + q_a E^2 + (1 + c) L_a + (1 + lambda) H_a + (1 + s) s_a T_hat            [-]
+// The plant's loop scale acts on both sides alike (so lambda is the actuator's too); the
+// coupling d cannot be told from the stress by E and D, so it follows the equivalent temperature
+// with its coefficient per K, and so does the actuator's linear part (d E).
+//
+// A sample whose inputs are not finite or outside the identification range (widened by
+// range_margin of its span) is rejected as models::Reconstruction rejects it: the operators
+// advance with the last accepted inputs, the estimator learns nothing and drops its anchor.
+//
+// Real-time safe after construction: step(), save_state(), restore_state() are noexcept and
+// allocate nothing.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <span>
+
+#include "selfsense/adaptation/drift_estimator.hpp"
+#include "selfsense/models/model_identity.hpp"
+#include "selfsense/models/reconstructor.hpp"
+#include "selfsense/models/runtime_model.hpp"
+#include "selfsense/models/sample_status.hpp"
+#include "selfsense/models/transducer_model.hpp"
+#include "selfsense/operators/dead_zone_superposition.hpp"
+
+namespace selfsense::adaptation {
+
+// A side's response r = G[E] (without the offset y0) split into its linear capacitive part L
+// and the loop H = r - L, read after the side's step_unloaded(E):
+//   L_in = w0 E + sum_j c_0j z_0j     the PI's linear weight and the creep of E itself (the
+//                                     lags on creep threshold 0)
+//   y_in = S^-1[r]                    the superposition's input (PI, hinges and creep)
+//   H = s0 (y_in - L_in),  L = r - H  the loop through the superposition's linear weight; the
+//                                     dead zones' bending counts with the linear part
+// (measured on the 25 -> 55 degC ramp with the recorded temperature: T_hat 0.71 % this way,
+// 1.01 % sharing the superposition in proportion, 1.82 % with the bending in the loop;
+// docs/adaptation.md).
+// Construction allocates (the superposition's inverse); split() is real-time safe.
+class SideSplit final {
+ public:
+  struct Parts {
+    double linear{0.0};  // L
+    double loop{0.0};    // H
+  };
+  explicit SideSplit(const models::SideOperator& side);
+  [[nodiscard]] Parts split(const models::SideOperator& side, double field,
+                            double response) const noexcept;
+
+ private:
+  operators::DeadZoneSuperposition inverse_shape_;
+};
+
+class AdaptedReconstruction final {
+ public:
+  struct Estimate {
+    double stress{0.0};  // T_hat [Pa]
+    double strain{0.0};  // S_hat [-]; NaN without an actuator side
+    models::SampleStatus status{models::SampleStatus::kOk};
+  };
+
+  // sample_time 0: the model's own. Throws std::invalid_argument naming the reason if the
+  // model cannot be adapted (charge drive, vectorial, corrections, no stress coupling) or the
+  // configuration is invalid.
+  AdaptedReconstruction(const models::TransducerModel& model, const DriftEstimatorConfig& config,
+                        double sample_time = 0.0, double range_margin = 0.5);
+
+  Estimate step(double field, double sensed) noexcept;
+
+  [[nodiscard]] Drift drift() const noexcept { return estimator_.drift(); }
+  [[nodiscard]] const DriftEstimator& estimator() const noexcept { return estimator_; }
+  // A measured temperature [degC] sets the drift instead of the estimate (until the next learn).
+  void set_temperature(double degc) noexcept { estimator_.set_temperature(degc); }
+  void set_frozen(bool frozen) noexcept { estimator_.set_frozen(frozen); }
+  [[nodiscard]] const models::StatusCounts& counts() const noexcept { return counts_; }
+  [[nodiscard]] bool has_strain() const noexcept { return kernel_.actuator().has_value(); }
+
+  // The kernel's operator state followed by the estimator's.
+  [[nodiscard]] std::size_t state_size() const noexcept;
+  // False (nothing written or read) if the span's size is not state_size().
+  bool save_state(std::span<double> out) const noexcept;
+  bool restore_state(std::span<const double> in) noexcept;
+  // With the model's identity (models/model_identity.hpp: its structure and parameter hash,
+  // and this state's size, so a plain Reconstruction's state of the same model is refused as
+  // kWrongSize): a restart resumes the learned drift only into the same model.
+  [[nodiscard]] const models::ModelIdentity& identity() const noexcept { return identity_; }
+  [[nodiscard]] models::SavedState make_saved_state() const;  // allocates
+  bool save_state(models::SavedState& out) const noexcept;
+  models::RestoreResult restore_state(const models::SavedState& in) noexcept;
+
+ private:
+  struct Tag {};
+  AdaptedReconstruction(const models::TransducerModel& model, const DriftEstimatorConfig& config,
+                        double range_margin, Tag /*unused*/);
+  Estimate kernel_step(double field, double sensed, bool accepted) noexcept;
+
+  models::Reconstructor kernel_;
+  SideSplit sensor_split_;
+  std::optional<SideSplit> actuator_split_{};
+  DriftEstimator estimator_;
+  models::detail::InputGate gate_{};
+  models::detail::HeldInputs held_{};
+  Estimate last_{};
+  models::StatusCounts counts_{};
+  models::ModelIdentity identity_{};
+};
+
+}  // namespace selfsense::adaptation

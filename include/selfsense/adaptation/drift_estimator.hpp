@@ -1,0 +1,127 @@
+// Online estimate of the sensor side's drift from E and D alone (issue 24, docs/adaptation.md):
+// the relative change of the permittivity (epsilon) and of the hysteresis loop (lambda) against
+// the model identified at the reference temperature, by recursive least squares with
+// forgetting on field increments, and the equivalent temperature that the permittivity change
+// means.
+//
+// Measurement model (field drive; the model's sensor response split into its linear capacitive
+// part L and the loop H, adapted_reconstruction.hpp's SideSplit; the stress coupling d):
+//   D = y0 + (1 + epsilon) L + (1 + lambda) H + d' T                                [C/m^2]
+// Between an anchor sample a and the present sample k (delta x = x[k] - x[a]):
+//   z = delta D - delta L - delta H = epsilon delta L + lambda delta H + d' delta T
+// The stress is unknown, but it moves slowly against the field over the short interval between
+// anchor and update, so d' delta T is noise; a constant stress, a charge offset and a slow
+// charge drift cancel in the increments.
+//
+// Parameters: with learn_loop false (default) one, epsilon, and the loop tied to it through the
+// coefficients per K, lambda = (loop_per_k / permittivity_per_k) epsilon, so
+//   phi = delta L + (loop_per_k / permittivity_per_k) delta H;
+// with learn_loop two, phi = [delta L, delta H], theta = [epsilon, lambda].
+//
+// Gates (excitation): an update happens only when |delta E| >= min_field_step_v_per_m within
+// max_interval_s of the anchor; then the anchor moves to k. An anchor older than
+// max_interval_s moves to k without an update (a hold, or a field too slow to tell drift from
+// a moving stress). A rejected sample (accepted == false: non-finite, out of range, a driver
+// fault) drops the anchor, so no increment spans it. frozen: nothing is learned, the estimate
+// holds.
+//
+// RLS with forgetting factor mu = 1 - 1 / memory_updates, applied only on updates (no
+// covariance wind-up on holds):
+//   K = P phi / (mu + phi' P phi),   theta += K (z - phi' theta),   P = (P - K phi' P) / mu
+// then theta is clamped to +-max_relative_change and P scaled back to trace <= p0 per
+// parameter. phi and z are divided by c0 min_field_step_v_per_m (a smallest update's capacitive
+// increment, c0 the model's linear weight), so they are dimensionless and about 1.
+//
+// Equivalent temperature: theta_eq = reference_degc + epsilon / permittivity_per_k [degC]; the
+// coupling and compliance follow it: d' = (1 + coupling_per_k (theta_eq - reference)) d.
+//
+// Real-time safe after construction: step(), save_state(), restore_state() are noexcept and
+// allocate nothing.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <span>
+#include <string>
+
+namespace selfsense::adaptation {
+
+struct DriftEstimatorConfig {
+  bool frozen{false};  // learn nothing, hold the estimate
+  // false: the loop follows the permittivity through the coefficients per K,
+  // lambda = (loop_per_k / permittivity_per_k) epsilon, and one parameter is learned (better
+  // conditioned: L and H move together on most field paths); true: lambda is learned too.
+  bool learn_loop{false};
+  double min_field_step_v_per_m{20.0e3};  // excitation gate on |delta E| [V/m]
+  double max_interval_s{0.05};            // longest anchor-to-update interval [s]
+  double memory_updates{500.0};           // forgetting: mu = 1 - 1 / memory_updates
+  double initial_variance{1.0};           // p0: P = p0 I at the start [1]
+  double max_relative_change{0.5};        // bound on |epsilon| and |lambda| [1]
+  // The temperature coefficients the drift is read with (config/plant/temperature.yaml):
+  double reference_degc{25.0};        // the model's identification temperature [degC]
+  double permittivity_per_k{4.0e-3};  // [1/K], must not be 0
+  double loop_per_k{-4.0e-3};         // the hysteresis loop [1/K]
+  double coupling_per_k{2.0e-3};      // d: the sensor coupling and the actuator's linear part
+  double compliance_per_k{5.0e-4};    // the actuator's stress coupling s^E [1/K]
+
+  // Every value finite; steps, intervals, memory > 1, variance, bound positive;
+  // permittivity_per_k non-zero. *why names the key under `prefix` ("adaptation.memory_updates:
+  // must be > 1").
+  [[nodiscard]] bool is_valid(const std::string& prefix, std::string* why) const;
+};
+
+// The drift as estimated: relative changes against the model, and what they mean.
+struct Drift {
+  double permittivity{0.0};  // epsilon [1]: eps = (1 + epsilon) eps_ref
+  double loop{0.0};          // lambda [1]: loop amplitude (1 + lambda) times the model's
+  double coupling{0.0};      // d' = (1 + coupling) d: coupling_per_k times the temperature rise
+  double compliance{0.0};    // s' = (1 + compliance) s
+  double temperature_degc{25.0};  // the equivalent temperature
+};
+
+class DriftEstimator final {
+ public:
+  // c0: the model's linear capacitive weight [C/(V m)] (header comment). Throws
+  // std::invalid_argument (message naming the key) on an invalid configuration, a non-positive
+  // sample time or c0 <= 0.
+  DriftEstimator(const DriftEstimatorConfig& config, double sample_time_s, double c0);
+
+  // One sample: the measured field E [V/m] and displacement D [C/m^2], the model's linear
+  // part L and loop part H at E [C/m^2] (header comment) and whether the sample was accepted.
+  // Returns true when it updated.
+  bool step(double field, double sensed, double linear_part, double loop_part,
+            bool accepted) noexcept;
+
+  [[nodiscard]] Drift drift() const noexcept;
+  [[nodiscard]] std::size_t updates() const noexcept { return updates_; }
+  void set_frozen(bool frozen) noexcept { config_.frozen = frozen; }
+  [[nodiscard]] bool frozen() const noexcept { return config_.frozen; }
+  // Sets the drift from a measured temperature instead of learning it (a temperature sensor):
+  // epsilon = permittivity_per_k dT, lambda = loop_per_k dT.
+  void set_temperature(double degc) noexcept;
+  [[nodiscard]] const DriftEstimatorConfig& config() const noexcept { return config_; }
+
+  [[nodiscard]] static constexpr std::size_t state_size() noexcept { return kStateSize; }
+  void save_state(std::span<double> out) const noexcept;
+  void restore_state(std::span<const double> in) noexcept;
+
+ private:
+  // theta (2), P (4), anchor E, D, L, H, anchor age, anchored, updates.
+  static constexpr std::size_t kStateSize{13};
+
+  DriftEstimatorConfig config_;
+  double ts_{0.0};
+  double scale_{1.0};  // 1 / (c0 min_field_step)
+  double mu_{1.0};
+  std::array<double, 2> theta_{};
+  std::array<double, 4> p_{};  // row major
+  double anchor_e_{0.0};
+  double anchor_d_{0.0};
+  double anchor_l_{0.0};
+  double anchor_h_{0.0};
+  double anchor_age_s_{0.0};
+  bool anchored_{false};
+  std::size_t updates_{0};
+};
+
+}  // namespace selfsense::adaptation

@@ -1,0 +1,170 @@
+#include "selfsense/adaptation/adapted_reconstruction.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace selfsense::adaptation {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The model at the loop's sample time, refused by name where the adaptation cannot run.
+models::TransducerModel adaptable(models::TransducerModel model, double sample_time) {
+  if (model.drive() != models::Drive::kField) {
+    throw std::invalid_argument{"adaptation: needs a field-driven model (E in, D sensed)"};
+  }
+  if (model.vectorial) {
+    throw std::invalid_argument{
+        "adaptation: the stress-dependent (vectorial) model is not adapted"};
+  }
+  if (model.sensed_correction || model.strain_correction) {
+    throw std::invalid_argument{"adaptation: a model with diagnosed corrections is not adapted"};
+  }
+  if (!model.sensor || model.sensor->linear_gains.empty() ||
+      model.sensor->linear_gains.front() == 0.0) {
+    throw std::invalid_argument{"adaptation: needs a sensor side with a stress coupling"};
+  }
+  if (!(sample_time >= 0.0)) throw std::invalid_argument{"adaptation: sample time must be >= 0"};
+  if (sample_time > 0.0) {
+    model.sample_time = sample_time;
+    model.sensor->sample_time = sample_time;
+    if (model.actuator) model.actuator->sample_time = sample_time;
+  }
+  return model;
+}
+
+// c0: the operator's slope right after a reversal (the PI's linear weight through the
+// superposition's).
+double linear_weight(const models::SideOperator& side) noexcept {
+  const auto& p = side.op().params();
+  return p.hysteresis.linear_weight * p.superposition.linear_weight;
+}
+
+}  // namespace
+
+SideSplit::SideSplit(const models::SideOperator& side)
+    : inverse_shape_{operators::DeadZoneSuperposition(side.op().params().superposition).inverse()} {
+}
+
+SideSplit::Parts SideSplit::split(const models::SideOperator& side, double field,
+                                  double response) const noexcept {
+  const auto& p = side.op().params();
+  double creep = 0.0;
+  const std::size_t cols = p.creep.eigenvalues.size();
+  if (!p.creep.thresholds.empty() && p.creep.thresholds.front() == 0.0) {
+    const std::span<const double> state = side.op().state();
+    const std::size_t lags = state.size() - p.creep.thresholds.size() * cols;
+    for (std::size_t j = 0; j < cols; ++j)
+      creep += p.creep.weights[j] * state[lags + j];
+  }
+  const double linear_in = p.hysteresis.linear_weight * field + creep;
+  const double loop =
+      p.superposition.linear_weight * (inverse_shape_.evaluate(response) - linear_in);
+  return {response - loop, loop};
+}
+
+AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& model,
+                                             const DriftEstimatorConfig& config, double sample_time,
+                                             double range_margin)
+    : AdaptedReconstruction(adaptable(model, sample_time), config, range_margin, Tag{}) {}
+
+AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& model,
+                                             const DriftEstimatorConfig& config,
+                                             double range_margin, Tag /*unused*/)
+    : kernel_(model),
+      sensor_split_(*kernel_.sensor()),
+      estimator_(config, model.sample_time, linear_weight(*kernel_.sensor())),
+      gate_(model.drive_range, model.sensed_range, range_margin),
+      last_{0.0, kNaN, models::SampleStatus::kOk} {
+  if (kernel_.actuator()) actuator_split_.emplace(*kernel_.actuator());
+  identity_ = {model.structure, models::parameter_hash(model), state_size()};
+  if (!(range_margin >= 0.0)) {
+    throw std::invalid_argument{"adaptation: range_margin must be >= 0"};
+  }
+}
+
+AdaptedReconstruction::Estimate AdaptedReconstruction::step(double field, double sensed) noexcept {
+  const models::SampleStatus status = gate_.check(field, sensed);
+  if (status != models::SampleStatus::kOk) {
+    counts_.add(status);
+    if (held_.valid) {
+      const models::SampleStatus previous = last_.status;
+      last_ = kernel_step(held_.first, held_.second, false);
+      last_.status = previous;
+    }
+    Estimate out = last_;
+    out.status = status;
+    return out;
+  }
+  const Estimate out = kernel_step(field, sensed, true);
+  counts_.add(out.status);
+  held_ = {field, sensed, true};
+  last_ = out;
+  return out;
+}
+
+AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field, double sensed,
+                                                                   bool accepted) noexcept {
+  models::SideOperator& s = *kernel_.sensor();
+  const double fixed_s = s.offset() + s.quadratic() * field * field;  // not scaled by the drift
+  const SideSplit::Parts ps = sensor_split_.split(s, field, s.step_unloaded(field) - fixed_s);
+  estimator_.step(field, sensed - fixed_s, ps.linear, ps.loop, accepted);
+  const Drift dr = estimator_.drift();
+  const double unloaded = fixed_s + (1.0 + dr.permittivity) * ps.linear + (1.0 + dr.loop) * ps.loop;
+  Estimate out{(sensed - unloaded) / ((1.0 + dr.coupling) * s.coupling()), kNaN,
+               models::SampleStatus::kOk};
+  if (kernel_.actuator()) {
+    models::SideOperator& a = *kernel_.actuator();
+    const double fixed_a = a.offset() + a.quadratic() * field * field;
+    const SideSplit::Parts pa = actuator_split_->split(a, field, a.step_unloaded(field) - fixed_a);
+    out.strain = fixed_a + (1.0 + dr.coupling) * pa.linear + (1.0 + dr.loop) * pa.loop +
+                 (1.0 + dr.compliance) * a.coupling() * out.stress;
+  }
+  return out;
+}
+
+std::size_t AdaptedReconstruction::state_size() const noexcept {
+  return kernel_.state_size() + DriftEstimator::state_size();
+}
+
+bool AdaptedReconstruction::save_state(std::span<double> out) const noexcept {
+  if (out.size() != state_size()) return false;
+  kernel_.save_state(out.first(kernel_.state_size()));
+  estimator_.save_state(out.subspan(kernel_.state_size()));
+  return true;
+}
+
+bool AdaptedReconstruction::restore_state(std::span<const double> in) noexcept {
+  if (in.size() != state_size()) return false;
+  kernel_.restore_state(in.first(kernel_.state_size()));
+  estimator_.restore_state(in.subspan(kernel_.state_size()));
+  return true;
+}
+
+models::SavedState AdaptedReconstruction::make_saved_state() const {
+  return {identity_, std::vector<double>(identity_.state_size, 0.0)};
+}
+
+bool AdaptedReconstruction::save_state(models::SavedState& out) const noexcept {
+  if (out.values.size() != identity_.state_size) return false;
+  out.identity = identity_;
+  return save_state(std::span<double>(out.values));
+}
+
+models::RestoreResult AdaptedReconstruction::restore_state(const models::SavedState& in) noexcept {
+  if (in.identity.structure != identity_.structure ||
+      in.identity.parameter_hash != identity_.parameter_hash) {
+    return models::RestoreResult::kWrongModel;
+  }
+  if (in.identity.state_size != identity_.state_size || in.values.size() != identity_.state_size) {
+    return models::RestoreResult::kWrongSize;
+  }
+  restore_state(std::span<const double>(in.values));
+  return models::RestoreResult::kOk;
+}
+
+}  // namespace selfsense::adaptation

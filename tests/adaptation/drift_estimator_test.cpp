@@ -1,0 +1,274 @@
+// The drift estimator and the adapted reconstruction on synthetic data whose drift is known:
+// convergence, the gates (holds, rejected samples, frozen), the bounds, saved state, and the
+// real-time path (no allocation, no lock).
+#include "selfsense/adaptation/drift_estimator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "selfsense/adaptation/adapted_reconstruction.hpp"
+#include "support/allocation_counter.hpp"
+#include "support/transducer_data.hpp"
+
+namespace selfsense::adaptation {
+namespace {
+
+static_assert(noexcept(std::declval<DriftEstimator&>().step(0.0, 0.0, 0.0, 0.0, true)));
+static_assert(noexcept(std::declval<AdaptedReconstruction&>().step(0.0, 0.0)));
+
+constexpr double kTs = 1e-4;
+
+// The typical transducer whose sensor side drifted by (epsilon, lambda) and coupling by
+// `coupling`: E, D, the true T, and the model with the sensed range it would have recorded.
+struct Drifted {
+  models::TransducerModel model;
+  std::vector<double> e, d, t;
+};
+
+Drifted drifted(double epsilon, double lambda, double coupling, std::size_t n, std::uint64_t seed) {
+  Drifted out{test::typical_transducer(kTs), {}, {}, {}};
+  const models::SideModel& sensor = *out.model.sensor;
+  models::SideOperator truth(sensor);
+  const SideSplit split(truth);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01;
+  double lo = 1e300;
+  double hi = -1e300;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double time = static_cast<double>(k) * kTs;
+    const double e = 1e6 * (1.0 + 0.9 * std::sin(2 * std::numbers::pi * 3.0 * time) *
+                                      std::cos(2 * std::numbers::pi * 0.23 * time));
+    const double t = -1e7 * (1.0 + 0.5 * std::sin(2 * std::numbers::pi * 0.2 * time + 0.5));
+    const SideSplit::Parts parts = split.split(truth, e, truth.step_unloaded(e) - sensor.offset);
+    const double d = sensor.offset + (1.0 + lambda) * parts.loop + (1.0 + epsilon) * parts.linear +
+                     (1.0 + coupling) * truth.coupling() * t + 2e-6 * n01(rng);
+    out.e.push_back(e + 100.0 * n01(rng));
+    out.d.push_back(d);
+    out.t.push_back(t);
+    lo = std::min(lo, d);
+    hi = std::max(hi, d);
+  }
+  out.model.drive_range = models::InputRange{0.0, 2e6};
+  out.model.sensed_range = models::InputRange{lo, hi};
+  return out;
+}
+
+TEST(DriftEstimatorConfig, NamesTheViolatedKey) {
+  std::string why;
+  DriftEstimatorConfig c{};
+  EXPECT_TRUE(c.is_valid("adaptation.", &why)) << why;
+  c.memory_updates = 1.0;
+  EXPECT_FALSE(c.is_valid("adaptation.", &why));
+  EXPECT_EQ(why, "adaptation.memory_updates: must be > 1");
+  c = DriftEstimatorConfig{};
+  c.permittivity_per_k = 0.0;
+  EXPECT_FALSE(c.is_valid("adaptation.", &why));
+  EXPECT_EQ(why, "adaptation.permittivity_per_k: must not be 0");
+  c = DriftEstimatorConfig{};
+  c.max_relative_change = std::nan("");
+  EXPECT_FALSE(c.is_valid("x.", &why));
+  EXPECT_EQ(why, "x.max_relative_change: must be finite");
+  EXPECT_THROW(DriftEstimator(c, kTs, 1.0), std::invalid_argument);
+  EXPECT_THROW(DriftEstimator(DriftEstimatorConfig{}, kTs, 0.0), std::invalid_argument);
+}
+
+struct Found {
+  Drift drift;
+  std::size_t updates;
+  double err_adapted, err_plain;  // max |T_hat - T| over the second half [Pa]
+};
+
+Found run(const Drifted& data, const DriftEstimatorConfig& config) {
+  AdaptedReconstruction rec(data.model, config);
+  models::Reconstructor plain(data.model);
+  Found f{};
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    const double t_adapted = rec.step(data.e[k], data.d[k]).stress;
+    const double t_plain = plain.step(data.e[k], data.d[k]).stress;
+    if (k < data.e.size() / 2) continue;  // converged by then
+    f.err_adapted = std::max(f.err_adapted, std::abs(t_adapted - data.t[k]));
+    f.err_plain = std::max(f.err_plain, std::abs(t_plain - data.t[k]));
+  }
+  f.drift = rec.drift();
+  f.updates = rec.estimator().updates();
+  std::printf("max |T_hat - T|: adapted %.3g Pa, as identified %.3g Pa\n", f.err_adapted,
+              f.err_plain);
+  return f;
+}
+
+// A 20 K rise with the default coefficients: permittivity +8 %, loop -8 %, coupling +4 %. The
+// one learned parameter finds it: the equivalent temperature is 25 + 0.08 / 0.004 = 45 degC,
+// and the stress comes back with the coupling's drift applied.
+TEST(AdaptedReconstruction, FindsAKnownTemperatureRise) {
+  const Found f = run(drifted(0.08, -0.08, 0.04, 200000, 3), DriftEstimatorConfig{});
+  EXPECT_NEAR(f.drift.permittivity, 0.08, 0.002);
+  EXPECT_DOUBLE_EQ(f.drift.loop, -f.drift.permittivity);
+  EXPECT_NEAR(f.drift.temperature_degc, 45.0, 0.5);
+  EXPECT_NEAR(f.drift.coupling, 0.04, 0.001);
+  EXPECT_GT(f.updates, 1000U);
+  EXPECT_LT(f.err_adapted, 0.1 * f.err_plain);
+}
+
+// With learn_loop, a loop that softened less than the coefficients say (-6 % against +8 %
+// permittivity) is found as well.
+TEST(AdaptedReconstruction, LearnsTheLoopApartWhenAskedTo) {
+  DriftEstimatorConfig config{};
+  config.learn_loop = true;
+  config.memory_updates = 5000.0;
+  const Found f = run(drifted(0.08, -0.06, 0.04, 200000, 3), config);
+  EXPECT_NEAR(f.drift.permittivity, 0.08, 0.004);
+  EXPECT_NEAR(f.drift.loop, -0.06, 0.01);
+  EXPECT_NEAR(f.drift.temperature_degc, 45.0, 1.0);
+  EXPECT_LT(f.err_adapted, 0.1 * f.err_plain);
+}
+
+TEST(DriftEstimator, LearnsNothingOnHoldsRejectedSamplesOrWhenFrozen) {
+  DriftEstimator est(DriftEstimatorConfig{}, kTs, 2e-8);
+  // A hold: the field within noise of one value.
+  for (int k = 0; k < 100000; ++k)
+    EXPECT_FALSE(est.step(1e6 + 100.0 * std::sin(k), 0.03, 2e-2, 0.01, true));
+  EXPECT_EQ(est.updates(), 0U);
+  // Alternating rejected samples: no increment spans one.
+  for (int k = 0; k < 1000; ++k) {
+    const double e = 1e6 + 1e5 * (k % 2);
+    EXPECT_FALSE(est.step(e, 0.03 + 2.2e-8 * e, 2e-8 * e, 0.01, k % 2 == 0));
+  }
+  EXPECT_EQ(est.updates(), 0U);
+  // Moving with a drift: it learns; frozen, the same data teaches nothing.
+  for (int k = 0; k < 1000; ++k) {
+    const double e = 1e6 + 1e5 * (k % 2);
+    est.step(e, 0.03 + 2.2e-8 * e, 2e-8 * e, 0.01, true);
+  }
+  EXPECT_GT(est.updates(), 900U);
+  EXPECT_NEAR(est.drift().permittivity, 0.1, 1e-3);
+  est.set_frozen(true);
+  const Drift before = est.drift();
+  const std::size_t updates = est.updates();
+  for (int k = 0; k < 1000; ++k) {
+    const double e = 1e6 + 1e5 * (k % 2);
+    est.step(e, 0.03 + 2.6e-8 * e, 2e-8 * e, 0.01, true);
+  }
+  EXPECT_EQ(est.updates(), updates);
+  EXPECT_EQ(est.drift().permittivity, before.permittivity);
+}
+
+TEST(DriftEstimator, StaysWithinItsBounds) {
+  DriftEstimatorConfig c{};
+  c.max_relative_change = 0.2;
+  DriftEstimator est(c, kTs, 2e-8);
+  for (int k = 0; k < 2000; ++k) {
+    const double e = 1e6 + 1e5 * (k % 2);
+    est.step(e, 0.03 + 4e-8 * e, 2e-8 * e, 0.0, true);  // a doubled permittivity
+  }
+  EXPECT_DOUBLE_EQ(est.drift().permittivity, 0.2);
+  EXPECT_DOUBLE_EQ(est.drift().temperature_degc, 25.0 + 0.2 / 4e-3);
+}
+
+TEST(AdaptedReconstruction, SavedStateResumesExactly) {
+  const Drifted data = drifted(0.05, -0.03, 0.02, 60000, 4);
+  AdaptedReconstruction a(data.model, DriftEstimatorConfig{});
+  AdaptedReconstruction b(data.model, DriftEstimatorConfig{});
+  std::vector<double> state(a.state_size());
+  EXPECT_FALSE(a.save_state(std::span<double>(state).first(3)));
+  for (std::size_t k = 0; k < 30000; ++k)
+    a.step(data.e[k], data.d[k]);
+  ASSERT_TRUE(a.save_state(state));
+  ASSERT_TRUE(b.restore_state(state));
+  EXPECT_EQ(b.drift().permittivity, a.drift().permittivity);
+  for (std::size_t k = 30000; k < data.e.size(); ++k) {
+    const auto ea = a.step(data.e[k], data.d[k]);
+    const auto eb = b.step(data.e[k], data.d[k]);
+    ASSERT_EQ(ea.stress, eb.stress) << k;
+    ASSERT_EQ(ea.strain, eb.strain) << k;
+  }
+  EXPECT_EQ(a.estimator().updates(), b.estimator().updates());
+}
+
+// A restart resumes the learned drift only into the same model: a state of another model or a
+// plain Reconstruction's state of this one is refused and changes nothing.
+TEST(AdaptedReconstruction, SavedStateCarriesTheModelsIdentity) {
+  const Drifted data = drifted(0.05, -0.05, 0.025, 40000, 7);
+  AdaptedReconstruction a(data.model, DriftEstimatorConfig{});
+  for (std::size_t k = 0; k < data.e.size(); ++k)
+    a.step(data.e[k], data.d[k]);
+  models::SavedState saved = a.make_saved_state();
+  ASSERT_TRUE(a.save_state(saved));
+  AdaptedReconstruction b(data.model, DriftEstimatorConfig{});
+  EXPECT_EQ(b.restore_state(saved), models::RestoreResult::kOk);
+  EXPECT_EQ(b.drift().temperature_degc, a.drift().temperature_degc);
+  EXPECT_GT(b.drift().temperature_degc, 30.0);
+
+  models::TransducerModel other = data.model;
+  other.sensor->offset += 1e-4;
+  AdaptedReconstruction c(other, DriftEstimatorConfig{});
+  EXPECT_EQ(c.restore_state(saved), models::RestoreResult::kWrongModel);
+  EXPECT_EQ(c.drift().temperature_degc, 25.0);
+
+  const models::Reconstruction plain(data.model);
+  EXPECT_EQ(b.restore_state(plain.make_saved_state()), models::RestoreResult::kWrongSize);
+  models::SavedState wrong = b.make_saved_state();
+  wrong.values.pop_back();
+  EXPECT_FALSE(b.save_state(wrong));
+}
+
+TEST(AdaptedReconstruction, RejectsSpikesAndLearnsNothingFromThem) {
+  const Drifted data = drifted(0.05, -0.03, 0.02, 20000, 5);
+  AdaptedReconstruction rec(data.model, DriftEstimatorConfig{});
+  for (std::size_t k = 0; k < 10000; ++k)
+    rec.step(data.e[k], data.d[k]);
+  const std::size_t updates = rec.estimator().updates();
+  const auto spike = rec.step(20e6, data.d[10000]);
+  EXPECT_EQ(spike.status, models::SampleStatus::kInputOutOfRange);
+  EXPECT_EQ(rec.estimator().updates(), updates);
+  EXPECT_EQ(rec.step(std::nan(""), 0.0).status, models::SampleStatus::kInputNotFinite);
+  EXPECT_EQ(rec.counts()[models::SampleStatus::kInputOutOfRange], 1U);
+}
+
+TEST(AdaptedReconstruction, RefusesWhatItCannotAdapt) {
+  models::TransducerModel m = test::typical_transducer(kTs);
+  m.sensor->linear_gains = {0.0};
+  EXPECT_THROW(AdaptedReconstruction(m, DriftEstimatorConfig{}), std::invalid_argument);
+  m = test::typical_transducer(kTs);
+  EXPECT_NO_THROW(AdaptedReconstruction(m, DriftEstimatorConfig{}));
+  m.sensed_correction = models::ChannelCorrection{};
+  EXPECT_THROW(AdaptedReconstruction(m, DriftEstimatorConfig{}), std::invalid_argument);
+}
+
+// The real-time path: the adapted step, the estimator alone and the state saves allocate
+// nothing and take no lock.
+TEST(AdaptationRealTime, StepsAndStateSavesDoNotAllocateOrLock) {
+  const Drifted data = drifted(0.05, -0.03, 0.02, 5000, 6);
+  AdaptedReconstruction rec(data.model, DriftEstimatorConfig{});
+  DriftEstimator est(DriftEstimatorConfig{}, kTs, 2e-8);
+  models::Reconstructor plain(data.model);
+  const SideSplit split(*plain.sensor());
+  std::vector<double> state(rec.state_size());
+  models::SavedState saved = rec.make_saved_state();
+  std::vector<double> est_state(DriftEstimator::state_size());
+  double sink = 0.0;
+  test::AllocationCounter counter;
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    const AdaptedReconstruction::Estimate out = rec.step(data.e[k], data.d[k]);
+    rec.save_state(state);
+    rec.restore_state(state);
+    rec.save_state(saved);
+    sink += static_cast<double>(rec.restore_state(saved));
+    est.step(data.e[k], data.d[k], 2e-8 * data.e[k], 0.0, k % 7 != 0);
+    sink += split.split(*plain.sensor(), data.e[k], plain.sensor()->step_unloaded(data.e[k])).loop;
+    est.save_state(est_state);
+    est.restore_state(est_state);
+    sink += out.stress + out.strain + rec.drift().temperature_degc + est.drift().loop;
+  }
+  EXPECT_EQ(counter.count(), 0U);
+  EXPECT_EQ(counter.locks(), 0U);
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+}  // namespace
+}  // namespace selfsense::adaptation
