@@ -1,10 +1,10 @@
 #include "selfsense/operators/hysteresis_creep.hpp"
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <utility>
 
 #include "selfsense/operators/kernels.hpp"
@@ -16,7 +16,11 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Levels of one play (ascending, ending with the +inf sentinel) below v, found from the guess k.
+// A play moves by at most the input's step, so its segment usually stays or moves by one: that
+// one step is taken without a branch, and the loops after it are rarely entered.
 std::size_t levels_below(const double* levels, std::size_t k, double v) noexcept {
+  k += static_cast<std::size_t>(levels[k] < v);
+  k -= static_cast<std::size_t>(k > 0 && !(levels[k - 1] < v));
   while (levels[k] < v)
     ++k;
   while (k > 0 && !(levels[k - 1] < v))
@@ -137,30 +141,48 @@ HysteresisCreep::HysteresisCreep(Params params, double sample_time)
       }
     }
     segments_.assign(n, 0);
+    hinge_terms_.assign(n, 0.0);
   }
   state_.assign(n + creep_weights_.size(), 0.0);
   locate_segments();
 }
 
-double HysteresisCreep::hinge_sum(std::span<const double> plays) const noexcept {
-  double sum = 0.0;
-  for (std::size_t i = 0; i < segments_.size(); ++i)
-    sum += hinge_value(i, segments_[i], plays[i]);
-  return sum;
+double HysteresisCreep::hinge_sum() const noexcept {
+  return Eigen::Map<const Eigen::ArrayXd>(hinge_terms_.data(),
+                                          static_cast<Eigen::Index>(hinge_terms_.size()))
+      .sum();
 }
 
 void HysteresisCreep::locate_segments() noexcept {
-  for (std::size_t i = 0; i < segments_.size(); ++i)
+  for (std::size_t i = 0; i < segments_.size(); ++i) {
     segments_[i] = levels_below(hinge_levels_.data() + i * hinge_stride_, 0, state_[i]);
+    hinge_terms_[i] = hinge_value(i, segments_[i], state_[i]);
+  }
 }
 
 double HysteresisCreep::inner_step(double x) noexcept {
   const std::span<double> p = plays();
   const std::span<double> z = lags();
-  kernels::play_bank_step(x, thresholds_, p);
-  for (std::size_t i = 0; i < segments_.size(); ++i)
-    segments_[i] = levels_below(hinge_levels_.data() + i * hinge_stride_, segments_[i], p[i]);
-  double sum = kernels::dot(hysteresis_weights_, p) + hinge_sum(p);
+  double sum = 0.0;
+  if (segments_.empty()) {
+    kernels::play_bank_step(x, thresholds_, p);
+    sum = kernels::dot(hysteresis_weights_, p);
+  } else {
+    // A held play keeps its segment and its hinges' term; only the plays that moved (those of
+    // the smallest thresholds: a play moves only when every smaller one does) look theirs up.
+    // Each term is a function of its play's output alone, so the sum is the same as if every
+    // term were evaluated again (no drift).
+    std::copy(p.begin(), p.end(), scratch_.begin());
+    kernels::play_bank_step(x, thresholds_, p);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (p[i] != scratch_[i]) {
+        const std::size_t at = i * hinge_stride_;
+        segments_[i] = levels_below(hinge_levels_.data() + at, segments_[i], p[i]);
+        hinge_terms_[i] = hinge_value(i, segments_[i], p[i]);
+      }
+    }
+    sum = kernels::dot(hysteresis_weights_, p) + hinge_sum();
+  }
   const std::size_t cols = params_.creep.eigenvalues.size();
   for (std::size_t i = 0; i < creep_rows_.size(); ++i) {
     const std::size_t e = i * cols;
@@ -202,7 +224,7 @@ double HysteresisCreep::input_for(double y) noexcept {
 // b + r >= p + r), so only the moving plays' nearest levels are looked at: the levels next to
 // the play's output on the side it moves from (>= p moving up, < p moving down), and on the
 // input's play (r = 0, no kinks of its own) those next to x.
-HysteresisCreep::Trial HysteresisCreep::trial_inner(double x) const noexcept {
+HysteresisCreep::Trial HysteresisCreep::trial_inner(double x) noexcept {
   const std::span<const double> p = std::span<const double>(state_).first(play_count());
   const std::span<const double> w(effective_weights_);
   const std::size_t last = hinge_stride_ - 1;
@@ -211,7 +233,7 @@ HysteresisCreep::Trial HysteresisCreep::trial_inner(double x) const noexcept {
     const double* levels = hinge_levels_.data();
     const std::size_t below = levels_below(levels, segments_[0], x);
     const std::size_t upto = levels_at_or_below(levels, below, last, x);
-    t.value = w[0] * x + hinge_value(0, below, x);
+    scratch_[0] = w[0] * x + hinge_value(0, below, x);
     t.slope_down = w[0] + segment_slopes_[below];
     t.slope_up = w[0] + segment_slopes_[upto];
     t.above = levels[upto];
@@ -227,7 +249,7 @@ HysteresisCreep::Trial HysteresisCreep::trial_inner(double x) const noexcept {
       const double now = x - r;
       const std::size_t below = levels_below(levels, segments_[i], now);
       const std::size_t upto = levels_at_or_below(levels, below, last, now);
-      t.value += w[i] * now + hinge_value(i, below, now);
+      scratch_[i] = w[i] * now + hinge_value(i, below, now);
       t.slope_up += w[i] + segment_slopes_[at + upto];
       if (x > upper) t.slope_down += w[i] + segment_slopes_[at + below];
       t.below = std::max(t.below, upper < x ? upper : lower);
@@ -238,22 +260,24 @@ HysteresisCreep::Trial HysteresisCreep::trial_inner(double x) const noexcept {
       const double now = x + r;
       const std::size_t below = levels_below(levels, segments_[i], now);
       const std::size_t upto = levels_at_or_below(levels, below, last, now);
-      t.value += w[i] * now + hinge_value(i, below, now);
+      scratch_[i] = w[i] * now + hinge_value(i, below, now);
       t.slope_down += w[i] + segment_slopes_[at + below];
       if (x < lower) t.slope_up += w[i] + segment_slopes_[at + upto];
       t.above = std::min(t.above, lower > x ? lower : upper);
       if (levels[upto] < p[i]) t.above = std::min(t.above, levels[upto] - r);
       if (below > 0) t.below = std::max(t.below, levels[below - 1] - r);
     } else {  // held
-      t.value += w[i] * p[i] + hinge_value(i, segments_[i], p[i]);
+      scratch_[i] = w[i] * p[i] + hinge_terms_[i];
       t.below = std::max(t.below, lower);
       t.above = std::min(t.above, upper);
     }
   }
+  t.value =
+      Eigen::Map<const Eigen::ArrayXd>(scratch_.data(), static_cast<Eigen::Index>(p.size())).sum();
   return t;
 }
 
-double HysteresisCreep::solve_inner(double target, double start) const noexcept {
+double HysteresisCreep::solve_inner(double target, double start) noexcept {
   if (!std::isfinite(target)) return target;
   double x = start;
   double lo = -std::numeric_limits<double>::infinity();
@@ -304,8 +328,7 @@ void HysteresisCreep::apply_inverse(std::span<const double> y, std::span<double>
 
 double HysteresisCreep::output() const noexcept {
   const std::span<const double> all(state_);
-  return shape_.evaluate(kernels::dot(hysteresis_weights_, all.first(play_count())) +
-                         hinge_sum(all.first(play_count())) +
+  return shape_.evaluate(kernels::dot(hysteresis_weights_, all.first(play_count())) + hinge_sum() +
                          kernels::dot(creep_weights_, all.subspan(play_count())));
 }
 
