@@ -376,7 +376,7 @@ int main(int argc, char** argv) {
   const auto flag = std::find(args.begin(), args.end(), "--check");
   const bool check = flag != args.end();
   if (check) args.erase(flag);
-  const double seconds = args.size() > 0 ? std::strtod(args[0].c_str(), nullptr) : 10.0;
+  const double seconds = !args.empty() ? std::strtod(args[0].c_str(), nullptr) : 10.0;
   const int priority =
       args.size() > 1 ? static_cast<int>(std::strtol(args[1].c_str(), nullptr, 10)) : 80;
   const int cpu =

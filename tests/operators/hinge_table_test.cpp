@@ -59,9 +59,10 @@ class Reference {
       plays_[i] = std::min(std::max(plays_[i], x - r_[i]), x + r_[i]);
       sum += w_[i] * plays_[i];
     }
-    for (std::size_t h = 0; h < p_.hinges.thresholds.size(); ++h)
+    for (std::size_t h = 0; h < p_.hinges.thresholds.size(); ++h) {
       sum += p_.hinges.weights[h] *
              std::max(plays_[row(p_.hinges.thresholds[h])] - p_.hinges.levels[h], 0.0);
+    }
     for (std::size_t e = 0; e < lags_.size(); ++e) {
       lags_[e] += gain_[e] * (plays_[lag_row_[e]] - lags_[e]);
       sum += p_.creep.weights[e] * lags_[e];
