@@ -36,9 +36,9 @@
 // hinge. Results agree with the per-hinge sum to
 // rounding (tests/operators/hinge_table_test.cpp holds them to 1e-12 relative).
 //
-// step() and inverse_step() are real-time safe: O(n_plays + n_creep + n_deadzones + n_hinges)
-// (the inverse with hinges a bounded number of such evaluations), no allocation, no
-// exceptions.
+// step() and inverse_step() are real-time safe: O(n_plays + n_creep + n_deadzones), plus a
+// segment moved per level a play's output crosses (the inverse with hinges a bounded number of
+// such evaluations), no allocation, no exceptions.
 #pragma once
 
 #include <cstddef>
