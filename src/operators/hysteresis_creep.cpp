@@ -142,6 +142,9 @@ HysteresisCreep::HysteresisCreep(Params params, double sample_time)
     }
     segments_.assign(n, 0);
     hinge_terms_.assign(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!of_play[i].empty()) hinged_plays_.push_back(i);
+    }
   }
   state_.assign(n + creep_weights_.size(), 0.0);
   locate_segments();
@@ -153,8 +156,9 @@ double HysteresisCreep::hinge_sum() const noexcept {
       .sum();
 }
 
+// Plays without hinges keep a zero term (also at an infinite output, where 0 * inf is NaN).
 void HysteresisCreep::locate_segments() noexcept {
-  for (std::size_t i = 0; i < segments_.size(); ++i) {
+  for (const std::size_t i : hinged_plays_) {
     segments_[i] = levels_below(hinge_levels_.data() + i * hinge_stride_, 0, state_[i]);
     hinge_terms_[i] = hinge_value(i, segments_[i], state_[i]);
   }
@@ -174,7 +178,7 @@ double HysteresisCreep::inner_step(double x) noexcept {
     // term were evaluated again (no drift).
     std::copy(p.begin(), p.end(), scratch_.begin());
     kernels::play_bank_step(x, thresholds_, p);
-    for (std::size_t i = 0; i < p.size(); ++i) {
+    for (const std::size_t i : hinged_plays_) {
       if (p[i] != scratch_[i]) {
         const std::size_t at = i * hinge_stride_;
         segments_[i] = levels_below(hinge_levels_.data() + at, segments_[i], p[i]);

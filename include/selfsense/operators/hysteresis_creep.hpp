@@ -149,14 +149,15 @@ class HysteresisCreep final {
   std::vector<std::size_t> hinge_rows_{};  // play index of each hinge
   // Segments, play by play, hinge_stride_ = (most hinges on one play) + 1 entries each.
   std::size_t hinge_stride_{0};
-  std::vector<double> hinge_levels_{};     // ascending, then +inf (fewer hinges; the sentinel)
-  std::vector<double> segment_slopes_{};   // s_k
-  std::vector<double> segment_anchors_{};  // b_(k) (0 for k = 0)
-  std::vector<double> segment_values_{};   // g_k
-  std::vector<std::size_t> segments_{};    // per play: its levels below its output (state)
-  std::vector<double> hinge_terms_{};      // per play: g_i(p_i) (state)
-  double scale_{1.0};                      // input scale of the inverse's first step
-  std::vector<double> state_{};            // plays, then lags
+  std::vector<double> hinge_levels_{};       // ascending, then +inf (fewer hinges; the sentinel)
+  std::vector<double> segment_slopes_{};     // s_k
+  std::vector<double> segment_anchors_{};    // b_(k) (0 for k = 0)
+  std::vector<double> segment_values_{};     // g_k
+  std::vector<std::size_t> segments_{};      // per play: its levels below its output (state)
+  std::vector<double> hinge_terms_{};        // per play: g_i(p_i) (state)
+  std::vector<std::size_t> hinged_plays_{};  // the plays with hinges, ascending
+  double scale_{1.0};                        // input scale of the inverse's first step
+  std::vector<double> state_{};              // plays, then lags
   // The previous sample's inverse with hinges: where the next solve starts. Not the input
   // applied (state_[0]): in a loop the feedback moves that far from the feedforward's root.
   double last_root_{std::numeric_limits<double>::quiet_NaN()};
