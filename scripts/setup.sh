@@ -182,7 +182,8 @@ case "$mode" in
     # tolerance on this 2-core machine, and the CI budget is spent. The daemon runs under the
     # sanitizers in the process tests (kill -9, reloads) and the socket tests.
     # The packages (label package) are built and read back from the Release build only.
-    run_tests build-sanitize -LE 'accuracy|vm|soak|package'
+    # The speed tests (label perf) too: under the sanitizers a timing says nothing.
+    run_tests build-sanitize -LE 'accuracy|vm|soak|package|perf'
     say "fuzz: every target for ${FUZZ_SECONDS:-10} s on a copy of its corpus"
     run_fuzz build-sanitize
     run_thread_sanitizer

@@ -1,5 +1,6 @@
 #include "selfsense/operators/hysteresis_creep.hpp"
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -11,6 +12,30 @@
 
 namespace selfsense::operators {
 namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Levels of one play (ascending, ending with the +inf sentinel) below v, found from the guess k.
+// A play moves by at most the input's step, so its segment usually stays or moves by one: that
+// one step is taken without a branch, and the loops after it are rarely entered.
+std::size_t levels_below(const double* levels, std::size_t k, double v) noexcept {
+  k += static_cast<std::size_t>(levels[k] < v);
+  k -= static_cast<std::size_t>(k > 0 && !(levels[k - 1] < v));
+  while (levels[k] < v)
+    ++k;
+  while (k > 0 && !(levels[k - 1] < v))
+    --k;
+  return k;
+}
+
+// Levels at or below v, from k = levels_below(v): the slope on v's upper side counts a hinge
+// at exactly v. `last` bounds it to the play's table.
+std::size_t levels_at_or_below(const double* levels, std::size_t k, std::size_t last,
+                               double v) noexcept {
+  while (k < last && levels[k] <= v)
+    ++k;
+  return k;
+}
 
 // Position of value in the sorted union (it is there by construction).
 std::size_t index_in(std::span<const double> sorted, double value) {
@@ -85,22 +110,83 @@ HysteresisCreep::HysteresisCreep(Params params, double sample_time)
   PrandtlIshlinskii::inverse_parameters(thresholds_, effective_weights_, inverse_thresholds_,
                                         inverse_weights_);
   scratch_.resize(n);
+  // Segment tables: each play's hinges sorted by level (plays without hinges: segment 0).
+  if (!hinge_rows_.empty()) {
+    std::vector<std::vector<std::size_t>> of_play(n);
+    for (std::size_t k = 0; k < hinge_rows_.size(); ++k)
+      of_play[hinge_rows_[k]].push_back(k);
+    std::size_t most = 0;
+    for (const auto& hinges : of_play)
+      most = std::max(most, hinges.size());
+    hinge_stride_ = most + 1;
+    hinge_levels_.assign(n * hinge_stride_, kInf);
+    segment_slopes_.assign(n * hinge_stride_, 0.0);
+    segment_anchors_.assign(n * hinge_stride_, 0.0);
+    segment_values_.assign(n * hinge_stride_, 0.0);
+    const PlayHinges& g = params_.hinges;
+    for (std::size_t i = 0; i < n; ++i) {
+      std::vector<std::size_t>& hinges = of_play[i];
+      std::stable_sort(hinges.begin(), hinges.end(),
+                       [&](std::size_t a, std::size_t b) { return g.levels[a] < g.levels[b]; });
+      const std::size_t base = i * hinge_stride_;
+      for (std::size_t k = 1; k <= hinges.size(); ++k) {
+        const double anchor = g.levels[hinges[k - 1]];
+        hinge_levels_[base + k - 1] = anchor;
+        segment_anchors_[base + k] = anchor;
+        // g at the anchor and the slope above it, summed hinge by hinge (no cancellation).
+        for (std::size_t j = 0; j < k; ++j) {
+          segment_slopes_[base + k] += g.weights[hinges[j]];
+          segment_values_[base + k] += g.weights[hinges[j]] * (anchor - g.levels[hinges[j]]);
+        }
+      }
+    }
+    segments_.assign(n, 0);
+    hinge_terms_.assign(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!of_play[i].empty()) hinged_plays_.push_back(i);
+    }
+  }
   state_.assign(n + creep_weights_.size(), 0.0);
+  locate_segments();
 }
 
-double HysteresisCreep::hinge_sum(std::span<const double> plays) const noexcept {
-  double sum = 0.0;
-  const PlayHinges& g = params_.hinges;
-  for (std::size_t h = 0; h < hinge_rows_.size(); ++h)
-    sum += g.weights[h] * std::max(plays[hinge_rows_[h]] - g.levels[h], 0.0);
-  return sum;
+double HysteresisCreep::hinge_sum() const noexcept {
+  return Eigen::Map<const Eigen::ArrayXd>(hinge_terms_.data(),
+                                          static_cast<Eigen::Index>(hinge_terms_.size()))
+      .sum();
+}
+
+// Plays without hinges keep a zero term (also at an infinite output, where 0 * inf is NaN).
+void HysteresisCreep::locate_segments() noexcept {
+  for (const std::size_t i : hinged_plays_) {
+    segments_[i] = levels_below(hinge_levels_.data() + i * hinge_stride_, 0, state_[i]);
+    hinge_terms_[i] = hinge_value(i, segments_[i], state_[i]);
+  }
 }
 
 double HysteresisCreep::inner_step(double x) noexcept {
   const std::span<double> p = plays();
   const std::span<double> z = lags();
-  kernels::play_bank_step(x, thresholds_, p);
-  double sum = kernels::dot(hysteresis_weights_, p) + hinge_sum(p);
+  double sum = 0.0;
+  if (segments_.empty()) {
+    kernels::play_bank_step(x, thresholds_, p);
+    sum = kernels::dot(hysteresis_weights_, p);
+  } else {
+    // A held play keeps its segment and its hinges' term; only the plays that moved (those of
+    // the smallest thresholds: a play moves only when every smaller one does) look theirs up.
+    // Each term is a function of its play's output alone, so the sum is the same as if every
+    // term were evaluated again (no drift).
+    std::copy(p.begin(), p.end(), scratch_.begin());
+    kernels::play_bank_step(x, thresholds_, p);
+    for (const std::size_t i : hinged_plays_) {
+      if (p[i] != scratch_[i]) {
+        const std::size_t at = i * hinge_stride_;
+        segments_[i] = levels_below(hinge_levels_.data() + at, segments_[i], p[i]);
+        hinge_terms_[i] = hinge_value(i, segments_[i], p[i]);
+      }
+    }
+    sum = kernels::dot(hysteresis_weights_, p) + hinge_sum();
+  }
   const std::size_t cols = params_.creep.eigenvalues.size();
   for (std::size_t i = 0; i < creep_rows_.size(); ++i) {
     const std::size_t e = i * cols;
@@ -134,51 +220,68 @@ double HysteresisCreep::input_for(double y) noexcept {
 
 // sum_i (w_i + b_i) p_i(x) + hinges(p(x)) with p_i(x) = clamp(p_i, x - r_i, x + r_i): the
 // creep-free part of this sample's H + K (the carry is the rest). A play moves with x (slope
-// 1) where the clamp binds, else it holds; a hinge adds its slope while its play is above the
-// level. The function is linear between kinks (a play's at p_i -+ r_i, a hinge's where its
-// play's output crosses the level: b + r_i above p_i, b - r_i below), so the slopes are taken
-// on each side of x (x sits on a kink of every moving play: there the sides differ) up to the
-// nearest kinks below and above.
-HysteresisCreep::Trial HysteresisCreep::trial_inner(double x) const noexcept {
+// 1) where the clamp binds, else it holds; its hinges add their segment's slope while it moves.
+// The function is linear between kinks (a play's at p_i -+ r_i; a hinge's where its play's
+// output crosses the level: b + r_i above p_i, b - r_i below), so the slopes are taken on each
+// side of x (x sits on a kink of every moving play: there the sides differ) up to the nearest
+// kinks below and above. A held play's hinge kinks lie beyond its own kinks (b >= p gives
+// b + r >= p + r), so only the moving plays' nearest levels are looked at: the levels next to
+// the play's output on the side it moves from (>= p moving up, < p moving down), and on the
+// input's play (r = 0, no kinks of its own) those next to x.
+HysteresisCreep::Trial HysteresisCreep::trial_inner(double x) noexcept {
   const std::span<const double> p = std::span<const double>(state_).first(play_count());
-  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const std::span<const double> w(effective_weights_);
+  const std::size_t last = hinge_stride_ - 1;
   Trial t{0.0, 0.0, 0.0, -kInf, kInf};
-  const auto kink = [&](double at) {
-    if (at > x) t.above = std::min(t.above, at);
-    if (at < x) t.below = std::max(t.below, at);
-  };
-  // Does the play of row i move with x just below x / just above x?
-  const auto moves_down = [&](std::size_t i) {
-    return x <= p[i] - thresholds_[i] || x > p[i] + thresholds_[i];
-  };
-  const auto moves_up = [&](std::size_t i) {
-    return x >= p[i] + thresholds_[i] || x < p[i] - thresholds_[i];
-  };
-  for (std::size_t i = 0; i < p.size(); ++i) {
+  {  // The input's play: p_0(x) = x, moving on both sides.
+    const double* levels = hinge_levels_.data();
+    const std::size_t below = levels_below(levels, segments_[0], x);
+    const std::size_t upto = levels_at_or_below(levels, below, last, x);
+    scratch_[0] = w[0] * x + hinge_value(0, below, x);
+    t.slope_down = w[0] + segment_slopes_[below];
+    t.slope_up = w[0] + segment_slopes_[upto];
+    t.above = levels[upto];
+    if (below > 0) t.below = levels[below - 1];
+  }
+  for (std::size_t i = 1; i < p.size(); ++i) {
     const double r = thresholds_[i];
-    t.value += effective_weights_[i] * std::min(std::max(p[i], x - r), x + r);
-    if (moves_down(i)) t.slope_down += effective_weights_[i];
-    if (moves_up(i)) t.slope_up += effective_weights_[i];
-    if (r > 0.0) {
-      kink(p[i] - r);
-      kink(p[i] + r);
+    const double lower = p[i] - r;
+    const double upper = p[i] + r;
+    const double* levels = hinge_levels_.data() + i * hinge_stride_;
+    const std::size_t at = i * hinge_stride_;
+    if (x >= upper) {  // moving up with x (held just below x when x == upper)
+      const double now = x - r;
+      const std::size_t below = levels_below(levels, segments_[i], now);
+      const std::size_t upto = levels_at_or_below(levels, below, last, now);
+      scratch_[i] = w[i] * now + hinge_value(i, below, now);
+      t.slope_up += w[i] + segment_slopes_[at + upto];
+      if (x > upper) t.slope_down += w[i] + segment_slopes_[at + below];
+      t.below = std::max(t.below, upper < x ? upper : lower);
+      t.above = std::min(t.above, levels[upto] + r);
+      if (below > 0 && levels[below - 1] >= p[i])
+        t.below = std::max(t.below, levels[below - 1] + r);
+    } else if (x <= lower) {  // moving down with x (held just above x when x == lower)
+      const double now = x + r;
+      const std::size_t below = levels_below(levels, segments_[i], now);
+      const std::size_t upto = levels_at_or_below(levels, below, last, now);
+      scratch_[i] = w[i] * now + hinge_value(i, below, now);
+      t.slope_down += w[i] + segment_slopes_[at + below];
+      if (x < lower) t.slope_up += w[i] + segment_slopes_[at + upto];
+      t.above = std::min(t.above, lower > x ? lower : upper);
+      if (levels[upto] < p[i]) t.above = std::min(t.above, levels[upto] - r);
+      if (below > 0) t.below = std::max(t.below, levels[below - 1] - r);
+    } else {  // held
+      scratch_[i] = w[i] * p[i] + hinge_terms_[i];
+      t.below = std::max(t.below, lower);
+      t.above = std::min(t.above, upper);
     }
   }
-  const PlayHinges& g = params_.hinges;
-  for (std::size_t h = 0; h < hinge_rows_.size(); ++h) {
-    const std::size_t i = hinge_rows_[h];
-    const double r = thresholds_[i];
-    const double level = g.levels[h];
-    const double now = std::min(std::max(p[i], x - r), x + r);
-    if (now > level) t.value += g.weights[h] * (now - level);
-    if (now > level && moves_down(i)) t.slope_down += g.weights[h];
-    if (now >= level && moves_up(i)) t.slope_up += g.weights[h];
-    kink(level >= p[i] ? level + r : level - r);
-  }
+  t.value =
+      Eigen::Map<const Eigen::ArrayXd>(scratch_.data(), static_cast<Eigen::Index>(p.size())).sum();
   return t;
 }
 
-double HysteresisCreep::solve_inner(double target, double start) const noexcept {
+double HysteresisCreep::solve_inner(double target, double start) noexcept {
   if (!std::isfinite(target)) return target;
   double x = start;
   double lo = -std::numeric_limits<double>::infinity();
@@ -229,8 +332,7 @@ void HysteresisCreep::apply_inverse(std::span<const double> y, std::span<double>
 
 double HysteresisCreep::output() const noexcept {
   const std::span<const double> all(state_);
-  return shape_.evaluate(kernels::dot(hysteresis_weights_, all.first(play_count())) +
-                         hinge_sum(all.first(play_count())) +
+  return shape_.evaluate(kernels::dot(hysteresis_weights_, all.first(play_count())) + hinge_sum() +
                          kernels::dot(creep_weights_, all.subspan(play_count())));
 }
 
@@ -238,11 +340,13 @@ void HysteresisCreep::set_state(std::span<const double> state) noexcept {
   assert(state.size() == state_.size());
   last_root_ = std::numeric_limits<double>::quiet_NaN();
   std::copy(state.begin(), state.end(), state_.begin());
+  locate_segments();
 }
 
 void HysteresisCreep::reset(double x) noexcept {
   last_root_ = std::numeric_limits<double>::quiet_NaN();
   std::fill(state_.begin(), state_.end(), x);
+  locate_segments();
 }
 
 void HysteresisCreep::set_history(std::span<const double> turning_points) noexcept {
@@ -255,6 +359,7 @@ void HysteresisCreep::set_history(std::span<const double> turning_points) noexce
   for (std::size_t i = 0; i < creep_rows_.size(); ++i) {
     std::fill_n(z.begin() + static_cast<std::ptrdiff_t>(i * cols), cols, p[creep_rows_[i]]);
   }
+  locate_segments();
 }
 
 HysteresisCreepCompensator::HysteresisCreepCompensator(HysteresisCreep model, double input_min,

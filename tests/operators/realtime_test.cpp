@@ -47,6 +47,18 @@ TEST(RealTime, PerSampleStepsDoNotAllocate) {
   ThresholdCreep creep(sensor.params().creep, 1e-4);
   NonlinearCreep eq28(PrandtlIshlinskii(sensor.params().hysteresis),
                       LinearCreep({{10.0, 1.0}, {0.1, 0.1}}, 1e-4));
+  // With hinges on every play (the preisach-creep structure): the hinge table and the
+  // inverse's Newton solve.
+  HysteresisCreep::Params hinged = typical_stack_strain(size);
+  for (const double r : hinged.hysteresis.thresholds) {
+    for (const double level : {0.5e6, 1.0e6, 1.5e6}) {
+      hinged.hinges.thresholds.push_back(r);
+      hinged.hinges.levels.push_back(level);
+      hinged.hinges.weights.push_back(0.02 * hinged.hysteresis.linear_weight);
+    }
+  }
+  HysteresisCreep hinged_model(hinged, 1e-4);
+  HysteresisCreepCompensator hinged_feedforward(HysteresisCreep(hinged, 1e-4), 0.0, 2e6);
   PlayOperator play(0.5);
   StopOperator stop(0.5);
   const std::vector<double> e = test::random_walk(5000, 0.0, 2e6, 2e4, 1);
@@ -58,6 +70,7 @@ TEST(RealTime, PerSampleStepsDoNotAllocate) {
     sink += sensor.step(v) + actuator.step(v) + feedforward.step(1e-6 * v * 0.5e-3);
     sink += pi.step(v) + mpi_inv.step(mpi.step(v)) + creep.step(v) + eq28.step(v);
     sink += play.step(v) + stop.step(v) + sensor.inverse_step(0.05);
+    sink += hinged_model.step(v) + hinged_feedforward.step(1e-6 * v * 0.5e-3);
     sensor.set_state(saved);
   }
   EXPECT_EQ(counter.count(), 0U);
