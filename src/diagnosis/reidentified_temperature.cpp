@@ -1,3 +1,4 @@
+// Temperature dependence re-identified with its terms undone (reidentified.hpp). Pure math.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -17,7 +18,7 @@ using identification::CorrectionTerm;
 
 constexpr int kAlternations = 3;  // terms, then side, each time on the other's latest
 
-// The channel's side and temperature terms identified together on the first `samples` samples.
+// The channel's side and the temperature's terms identified together.
 struct Joint {
   models::TransducerModel model{};
   models::ChannelCorrection correction{};
@@ -31,16 +32,12 @@ class Identifier {
   Identifier(const models::TransducerModel& model, const Signals& s, const ChannelData& ch)
       : model_(model), s_(s), ch_(ch) {}
 
-  // The structure's side of this channel identified on `channel` over the first `samples`.
-  [[nodiscard]] models::TransducerModel identify(const std::vector<double>& channel,
-                                                 std::size_t samples) const {
-    const auto first = [samples](std::span<const double> x) {
-      return x.empty() ? x : x.first(samples);
-    };
+  // The structure's side of this channel identified on `channel` (the whole record).
+  [[nodiscard]] models::TransducerModel identify(std::span<const double> channel) const {
     identification::TransducerSignals t;
-    t.drive = first(s_.drive);
-    (ch_.sensed ? t.sensed : t.strain) = std::span<const double>(channel).first(samples);
-    t.stress = first(s_.stress);
+    t.drive = s_.drive;
+    (ch_.sensed ? t.sensed : t.strain) = channel;
+    t.stress = s_.stress;
     t.sample_time = s_.sample_time;
     return identification::identify(t, model_.structure,
                                     identification::defaults_for(model_.structure));
@@ -83,9 +80,8 @@ class Identifier {
   // terms undone). Throws as identification does.
   [[nodiscard]] Joint joint(std::span<const CorrectionTerm> terms,
                             const std::vector<bool>& rows) const {
-    const std::size_t n = s_.drive.size();
     Joint j;
-    j.model = identify({ch_.recorded.begin(), ch_.recorded.end()}, n);
+    j.model = identify(ch_.recorded);
     Joint best;
     for (int i = 0;; ++i) {
       j.base = output_of(j.model);
@@ -98,7 +94,7 @@ class Identifier {
       // the alternation need not descend, so the best pass on the fitting rows is kept.
       if (j.fit_sse < best.fit_sse) best = j;
       if (i == kAlternations) return best;
-      j.model = identify(undone(j.correction), n);
+      j.model = identify(undone(j.correction));
     }
   }
 
@@ -138,7 +134,7 @@ std::optional<Reidentified> reidentified_temperature(const models::TransducerMod
   const Candidate* candidate = nullptr;
   Rows rows;
   try {
-    null_output = id.output_of(id.identify({ch.recorded.begin(), ch.recorded.end()}, n));
+    null_output = id.output_of(id.identify(ch.recorded));
     rows = make_rows(hold_finite(null_output), options.blocks);
     candidate = &temperature_candidate(false);
     best = id.joint(candidate->terms, rows.fit);
