@@ -158,6 +158,16 @@ Rows forecast_rows(std::size_t n, std::size_t half, std::size_t judging,
   return r;
 }
 
+std::vector<Segment> where_it_changes(const std::vector<double>& output,
+                                      const std::vector<double>& current) {
+  std::vector<double> change(output.size());
+  for (std::size_t k = 0; k < output.size(); ++k)
+    change[k] = output[k] - current[k];
+  std::vector<Segment> where = large_segments(change, 1.5, 5);
+  if (where.empty()) where = {{0, output.size()}};
+  return where;
+}
+
 std::optional<Reidentified> reidentified_leak(const models::TransducerModel& model,
                                               const Signals& s, const ChannelData& ch,
                                               const std::vector<double>& current,
@@ -216,11 +226,7 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
   f.effect = "charge_leakage";
   f.channel = ch.name;
   f.explains = explains;
-  std::vector<double> change(n);
-  for (std::size_t k = 0; k < n; ++k)
-    change[k] = r.output[k] - current[k];
-  f.where = large_segments(change, 1.5, 5);
-  if (f.where.empty()) f.where = {{0, n}};
+  f.where = where_it_changes(r.output, current);
   const std::string judged = format(
       "on the last %.3g s of the recording as a forecast (the model's structure identified on "
       "the first half with the leak undone, against the same structure identified on D as "

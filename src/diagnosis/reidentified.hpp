@@ -51,6 +51,11 @@ struct Reidentified {
 [[nodiscard]] Rows forecast_rows(std::size_t n, std::size_t half, std::size_t judging,
                                  const std::vector<double>& a, const std::vector<double>& b);
 
+// Where a re-identified model's output departs most from the current one (the whole record when
+// the change is spread evenly): a finding's located segments.
+[[nodiscard]] std::vector<Segment> where_it_changes(const std::vector<double>& output,
+                                                    const std::vector<double>& current);
+
 // The best form of leak when it is significant; nullopt otherwise (or when the model or the
 // recording does not allow the test).
 [[nodiscard]] std::optional<Reidentified> reidentified_leak(const models::TransducerModel& model,

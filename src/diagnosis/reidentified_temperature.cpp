@@ -178,11 +178,7 @@ std::optional<Reidentified> reidentified_temperature(const models::TransducerMod
   f.effect = candidate->effect;
   f.channel = ch.name;
   f.explains = explains;
-  std::vector<double> change(n);
-  for (std::size_t k = 0; k < n; ++k)
-    change[k] = r.output[k] - current[k];
-  f.where = large_segments(change, 1.5, 5);
-  if (f.where.empty()) f.where = {{0, n}};
+  f.where = where_it_changes(r.output, current);
   const std::string judged =
       "on held-out blocks (the model's structure identified with the temperature's terms "
       "undone, the terms fitted on the other blocks, against the structure identified on " +
