@@ -133,6 +133,10 @@ class Device final {
   [[nodiscard]] std::int64_t period_ns() const noexcept { return period_ns_; }
   [[nodiscard]] std::uint64_t updates() const noexcept { return updates_; }
   [[nodiscard]] std::uint64_t bad_commands() const noexcept { return bad_commands_; }
+  [[nodiscard]] double skipped_s() const noexcept {
+    return 1e-9 * static_cast<double>(skipped_ns_);
+  }
+  void skip(std::int64_t ns) noexcept { skipped_ns_ += ns; }
 
   void update() {
     const std::span<std::uint16_t> command = words(map_.command);
@@ -173,6 +177,7 @@ class Device final {
   std::unique_ptr<modbus_mapping_t, MappingDeleter> mapping_{};
   std::uint64_t updates_{0};
   std::uint64_t bad_commands_{0};
+  std::int64_t skipped_ns_{0};
 };
 
 void set_priority(int priority) {
@@ -208,20 +213,31 @@ bool wait_until(std::vector<pollfd>& fds, std::int64_t deadline, const StopSigna
 void finish(const Device& device, const ServerCounts& counts) {
   static_cast<void>(std::printf(
       "sim-device: stopped after %llu updates, %llu requests, %llu connections, %llu bus errors, "
-      "%llu bad commands\n",
+      "%llu bad commands, %.3f s not replayed\n",
       static_cast<unsigned long long>(device.updates()),
       static_cast<unsigned long long>(counts.requests),
       static_cast<unsigned long long>(counts.connections),
       static_cast<unsigned long long>(counts.errors),
-      static_cast<unsigned long long>(device.bad_commands())));
+      static_cast<unsigned long long>(device.bad_commands()), device.skipped_s()));
   static_cast<void>(std::fflush(stdout));
 }
 
-// Next update deadline; a late update is not repeated to catch up.
-std::int64_t advance(std::int64_t next, std::int64_t period) {
-  next += period;
+// Runs every update that is due and returns the next deadline. A physical transducer does not
+// pause when its server is descheduled: the plant catches up on the periods it missed, with the
+// command held, so its clock stays the wall clock the daemon's model steps by. Beyond one second
+// behind it starts again from now (the missed time is counted, not replayed).
+std::int64_t run_due_updates(Device& device, std::int64_t next) {
+  const std::int64_t period = device.period_ns();
   const std::int64_t now = now_ns();
-  return next < now - period ? now + period : next;
+  if (now - next > 1'000'000'000) {
+    device.skip(now - next);
+    next = now;
+  }
+  while (next <= now) {
+    device.update();
+    next += period;
+  }
+  return next;
 }
 
 }  // namespace
@@ -256,10 +272,7 @@ int serve_modbus_tcp(const SimDeviceOptions& options, const std::string& host, i
   while (g_stop == 0) {
     if (wait_until(fds, next, signals)) {
       if (g_stop != 0) break;
-      if (now_ns() >= next) {
-        device.update();
-        next = advance(next, device.period_ns());
-      }
+      next = run_due_updates(device, next);
       continue;
     }
     for (std::size_t i = fds.size(); i-- > 0;) {
@@ -285,10 +298,7 @@ int serve_modbus_tcp(const SimDeviceOptions& options, const std::string& host, i
         fds.erase(fds.begin() + static_cast<std::ptrdiff_t>(i));
       }
     }
-    if (now_ns() >= next) {
-      device.update();
-      next = advance(next, device.period_ns());
-    }
+    next = run_due_updates(device, next);
   }
   for (std::size_t i = 1; i < fds.size(); ++i)
     close(fds[i].fd);
@@ -328,10 +338,7 @@ int serve_modbus_rtu(const SimDeviceOptions& options, const std::string& device_
         modbus_flush(ctx.get());
       }
     }
-    if (g_stop == 0 && now_ns() >= next) {
-      device.update();
-      next = advance(next, device.period_ns());
-    }
+    if (g_stop == 0) next = run_due_updates(device, next);
   }
   finish(device, counts);
   return 0;

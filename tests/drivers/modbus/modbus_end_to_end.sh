@@ -75,6 +75,10 @@ check() {  # check COLUMN LIMIT_PERCENT
 # True S 0.036-0.278 % (ten of them 0.043-0.083 %): the device's plant runs on its own clock in
 # another process and its spread is wide, so the figure is measured-only and asserted at the
 # daemon issue's goal (0.5 %), 1.8x the largest seen.
+# One CI run measured 0.742 % (S_hat 0.050 %), not reproduced here in 16 runs with and without
+# load. One way to get there was removed: a descheduled device used to drop the periods it
+# missed, so its plant fell behind the wall clock the daemon's model steps by; it now replays
+# them (sim_device_modbus.cpp).
 check S_hat 0.065
 check S 0.5
 # A clean run: no exception responses and no bad frames (a timeout or two may happen on a loaded
