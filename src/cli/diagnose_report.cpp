@@ -40,10 +40,6 @@ code { background: #f3f3f3; padding: 0 3px; word-break: break-all; }
 .plots { display: flex; flex-wrap: wrap; gap: 8px 16px; }
 figure { margin: 0; }
 figcaption { font-size: 12px; color: #555; max-width: 560px; }
-svg.plot { max-width: 100%; height: auto; }
-svg.plot text { font-size: 11px; fill: #222; }
-svg.plot .pt { font-size: 13px; font-weight: bold; }
-svg.plot .gr { stroke: #e6e6e6; }
 p.note { color: #555; }
 )";
 
@@ -372,7 +368,7 @@ void write_diagnosis_report(const ReportInput& input, const std::filesystem::pat
       "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; "
       "style-src 'unsafe-inline'\">\n<title>selfsense diagnose: " +
       escape_html(input.verdict) + "</title>\n<style>" + std::string(kStyle) +
-      "</style>\n</head>\n<body>\n";
+      std::string(plot_style()) + "</style>\n</head>\n<body>\n";
   html += header_section(input);
   html += fit_section(input);
   html += findings_section(input);

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <string_view>
 #include <system_error>
 #include <unordered_set>
 #include <utility>
@@ -22,6 +23,17 @@ constexpr int kMarginBottom = 46;
 constexpr std::size_t kLoopBudget = 3000;
 constexpr std::size_t kScatterBudget = 3000;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr std::size_t kMaxTicks = 12;
+constexpr double kBandOpacity = 0.3;
+constexpr std::string_view kDefaultBandColour = "#f5c242";
+
+constexpr std::string_view kPlotStyle = R"(
+svg.plot { max-width: 100%; height: auto; }
+svg.plot text { font-size: 11px; fill: #222; }
+svg.plot .pt { font-size: 13px; font-weight: bold; }
+svg.plot .al { font-size: 12px; }
+svg.plot .gr { stroke: #e6e6e6; }
+)";
 
 struct Range {
   double lo{std::numeric_limits<double>::infinity()};
@@ -194,27 +206,6 @@ Reduced reduce_points(std::span<const double> x, std::span<const double> y, std:
   }
 }
 
-// Tick values: 1, 2 or 5 times a power of ten, about five across the range.
-std::vector<double> ticks(const Range& r) {
-  std::vector<double> out;
-  const double raw = r.span() / 5.0;
-  if (!(raw > 0.0) || !std::isfinite(raw)) return out;
-  const double power = std::pow(10.0, std::floor(std::log10(raw)));
-  double step = power;
-  for (const double m : {2.0, 5.0, 10.0}) {
-    if (step >= raw) break;
-    step = m * power;
-  }
-  const double first = std::ceil(r.lo / step);
-  // At most a dozen; k + 1 == k far from zero (a range small against its offset) ends it too.
-  for (double k = first; k * step <= r.hi + 1e-9 * step && out.size() < 12; k += 1.0) {
-    const double v = k * step;
-    if (!out.empty() && v <= out.back()) break;
-    out.push_back(std::abs(v) < 1e-12 * step ? 0.0 : v);
-  }
-  return out;
-}
-
 // A pixel coordinate: one decimal, no exponent.
 void append_coordinate(std::string& out, double v) {
   // Ranges near the limits of double can make a coordinate overflow; never print nan or inf.
@@ -242,6 +233,54 @@ std::string coordinate(double v) {
 }
 
 }  // namespace
+
+std::string_view plot_style() {
+  return kPlotStyle;
+}
+
+double nice_step(double span, int target) {
+  if (!(span > 0.0) || !std::isfinite(span) || target <= 0) return 0.0;
+  const double raw = span / static_cast<double>(target);
+  const double power = std::pow(10.0, std::floor(std::log10(raw)));
+  for (const double m : {1.0, 2.0, 5.0}) {
+    // (1 + 1e-9): a span of exactly 5 steps keeps the step, rounding aside.
+    if (m * power * (1.0 + 1e-9) >= raw) return m * power;
+  }
+  return 10.0 * power;
+}
+
+std::vector<double> nice_ticks(double lo, double hi, int target) {
+  std::vector<double> out;
+  const double step = nice_step(hi - lo, target);
+  if (!(step > 0.0) || !std::isfinite(step)) return out;
+  const double first = std::ceil(lo / step - 1e-9);
+  // k + 1 == k far from zero (a range small against its offset) ends it too.
+  for (double k = first; k * step <= hi + 1e-9 * step && out.size() < kMaxTicks; k += 1.0) {
+    const double v = k * step;
+    if (!out.empty() && v <= out.back()) break;
+    out.push_back(std::abs(v) < 1e-9 * step ? 0.0 : v);
+  }
+  return out;
+}
+
+std::string format_tick(double value, double step) {
+  if (!std::isfinite(value)) return "n/a";
+  if (!(step > 0.0) || !std::isfinite(step)) return format_number(value);
+  std::array<char, 48> buf{};
+  const double decimals = std::max(0.0, -std::floor(std::log10(step) + 1e-9));
+  int n = 0;
+  if (decimals <= 6.0 && std::abs(value) < 1e7) {
+    if (std::abs(value) < 0.5 * step) value = 0.0;  // no "-0.0"
+    n = std::snprintf(buf.data(), buf.size(), "%.*f", static_cast<int>(decimals), value);
+  } else {
+    // Digits from the value's leading one down to the step's.
+    const double lead = value == 0.0 ? 0.0 : std::floor(std::log10(std::abs(value)));
+    const int digits =
+        static_cast<int>(std::clamp(lead - std::floor(std::log10(step)) + 1.0, 1.0, 15.0));
+    n = std::snprintf(buf.data(), buf.size(), "%.*g", digits, value);
+  }
+  return std::string(buf.data(), static_cast<std::size_t>(std::clamp(n, 0, 47)));
+}
 
 std::string escape_html(std::string_view text) {
   std::string out;
@@ -306,12 +345,29 @@ void SvgPlot::add_reference(std::string label, double y, std::string colour) {
 }
 
 void SvgPlot::add_band(double x0, double x1) {
+  add_band(x0, x1, "", std::string(kDefaultBandColour));
+}
+
+void SvgPlot::add_band(double x0, double x1, std::string label, std::string colour) {
   if (!std::isfinite(x0) || !std::isfinite(x1)) return;
-  bands_.push_back(Band{std::min(x0, x1), std::max(x0, x1)});
+  bands_.push_back(Band{std::min(x0, x1), std::max(x0, x1), std::move(label), std::move(colour)});
+}
+
+void SvgPlot::add_marker(std::string label, double x, std::string colour) {
+  if (!std::isfinite(x)) return;
+  markers_.push_back(Marker{std::move(label), x, std::move(colour)});
 }
 
 void SvgPlot::include_y(double y) {
   if (std::isfinite(y)) extra_y_.push_back(y);
+}
+
+void SvgPlot::include_x(double x) {
+  if (std::isfinite(x)) extra_x_.push_back(x);
+}
+
+void SvgPlot::set_legend_column(int width) {
+  legend_column_ = std::clamp(width, 0, width_ / 2);
 }
 
 void SvgPlot::add_series(std::string label, Kind kind, std::span<const double> x,
@@ -364,6 +420,8 @@ std::string SvgPlot::render() const {
     ry.include(s.y_hi);
   }
   const bool has_data = !rx.empty();
+  for (const double v : extra_x_)
+    rx.include(v);
   for (const Reference& r : references_)
     ry.include(r.y);
   for (const double v : extra_y_)
@@ -375,7 +433,7 @@ std::string SvgPlot::render() const {
   const Range yr = widened(ry, 0.05);
 
   const double left = kMarginLeft;
-  const double right = width_ - kMarginRight;
+  const double right = width_ - (legend_column_ > 0 ? legend_column_ : kMarginRight);
   const double top = kMarginTop;
   const double bottom = height_ - kMarginBottom;
   const auto px = [&](double v) { return left + (v - xr.lo) / xr.span() * (right - left); };
@@ -404,32 +462,36 @@ std::string SvgPlot::render() const {
     const double x0 = std::clamp(px(b.x0), left, right);
     const double x1 = std::clamp(px(b.x1), left, right);
     if (x1 <= x0 && b.x1 > b.x0) continue;  // outside the plot
-    out += "<rect x=\"" + coordinate(x0) + "\" y=\"" + coordinate(top) + "\" width=\"" +
-           coordinate(std::max(x1 - x0, 1.0)) + "\" height=\"" + coordinate(bottom - top) +
-           "\" fill=\"#f5c242\" fill-opacity=\"0.3\"/>\n";
+    append(out, "<rect x=\"", coordinate(x0), "\" y=\"", coordinate(top), "\" width=\"",
+           coordinate(std::max(x1 - x0, 1.0)), "\" height=\"", coordinate(bottom - top),
+           "\" fill=\"", escape_html(b.colour), "\" fill-opacity=\"", coordinate(kBandOpacity),
+           "\"/>\n");
   }
 
   // Grid and ticks.
   out += "<g class=\"ax\">\n";
-  for (const double v : ticks(xr)) {
+  const double x_step = nice_step(xr.span());
+  for (const double v : nice_ticks(xr.lo, xr.hi)) {
     const std::string x = coordinate(px(v));
     append(out, "<line x1=\"", x, "\" y1=\"", coordinate(top), "\" x2=\"", x, "\" y2=\"",
            coordinate(bottom + 4), "\" class=\"gr\"/><text x=\"", x, "\" y=\"",
-           coordinate(bottom + 16), "\" text-anchor=\"middle\">", format_number(v), "</text>\n");
+           coordinate(bottom + 16), "\" text-anchor=\"middle\">", format_tick(v, x_step),
+           "</text>\n");
   }
-  for (const double v : ticks(yr)) {
+  const double y_step = nice_step(yr.span());
+  for (const double v : nice_ticks(yr.lo, yr.hi)) {
     const std::string y = coordinate(py(v));
     append(out, "<line x1=\"", coordinate(left - 4), "\" y1=\"", y, "\" x2=\"", coordinate(right),
            "\" y2=\"", y, "\" class=\"gr\"/><text x=\"", coordinate(left - 6), "\" y=\"", y,
-           "\" dy=\"0.35em\" text-anchor=\"end\">", format_number(v), "</text>\n");
+           "\" dy=\"0.35em\" text-anchor=\"end\">", format_tick(v, y_step), "</text>\n");
   }
   out += "<text x=\"" + coordinate((left + right) / 2) + "\" y=\"" + coordinate(height_ - 8.0) +
-         "\" text-anchor=\"middle\">" + escape_html(x_label_) + "</text>\n";
+         "\" text-anchor=\"middle\" class=\"al\">" + escape_html(x_label_) + "</text>\n";
   const std::string ylx = coordinate(14);
   const std::string yly = coordinate((top + bottom) / 2);
   out += "<text x=\"" + ylx + "\" y=\"" + yly +
-         "\" text-anchor=\"middle\" transform=\"rotate(-90 " + ylx + " " + yly + ")\">" +
-         escape_html(y_label_) + "</text>\n</g>\n";
+         "\" text-anchor=\"middle\" class=\"al\" transform=\"rotate(-90 " + ylx + " " + yly +
+         ")\">" + escape_html(y_label_) + "</text>\n</g>\n";
 
   for (const Reference& r : references_) {
     const std::string y = coordinate(py(r.y));
@@ -490,37 +552,66 @@ std::string SvgPlot::render() const {
     }
   }
 
-  // Legend: top right inside the frame.
-  std::vector<std::pair<std::string, std::pair<std::string, bool>>> entries;
-  for (const Series& s : series_) {
-    if (!s.label.empty()) entries.push_back({s.label, {s.colour, false}});
+  for (const Marker& m : markers_) {
+    const double x = px(m.x);
+    if (x < left - 0.5 || x > right + 0.5) continue;
+    const std::string xs = coordinate(x);
+    append(out, "<line x1=\"", xs, "\" y1=\"", coordinate(top), "\" x2=\"", xs, "\" y2=\"",
+           coordinate(bottom), "\" stroke=\"", escape_html(m.colour),
+           "\" stroke-width=\"1.5\" stroke-dasharray=\"4 3\"/>\n");
   }
-  for (const Reference& r : references_) {
-    if (r.label.empty()) continue;
+
+  // Legend: top right inside the frame, or in the column right of it.
+  enum class Swatch { kLine, kDashed, kFill };
+  struct Entry {
+    std::string label;
+    std::string colour;
+    Swatch swatch{Swatch::kLine};
+  };
+  std::vector<Entry> entries;
+  const auto add_entry = [&entries](const std::string& label, const std::string& colour,
+                                    Swatch swatch) {
+    if (label.empty()) return;
     const bool seen = std::any_of(entries.begin(), entries.end(),
-                                  [&](const auto& e) { return e.first == r.label; });
-    if (!seen) entries.push_back({r.label, {r.colour, true}});
-  }
+                                  [&](const Entry& e) { return e.label == label; });
+    if (!seen) entries.push_back(Entry{label, colour, swatch});
+  };
+  for (const Series& s : series_)
+    add_entry(s.label, s.colour, Swatch::kLine);
+  for (const Reference& r : references_)
+    add_entry(r.label, r.colour, Swatch::kDashed);
+  for (const Marker& m : markers_)
+    add_entry(m.label, m.colour, Swatch::kDashed);
+  for (const Band& b : bands_)
+    add_entry(b.label, b.colour, Swatch::kFill);
   if (!entries.empty()) {
     std::size_t longest = 0;
-    for (const auto& e : entries)
-      longest = std::max(longest, e.first.size());
-    const double box_w = 34.0 + 6.5 * static_cast<double>(longest);
+    for (const Entry& e : entries)
+      longest = std::max(longest, e.label.size());
+    const bool column = legend_column_ > 0;
+    const double box_w = column ? legend_column_ - 12.0 : 34.0 + 6.5 * static_cast<double>(longest);
     const double box_h = 6.0 + 15.0 * static_cast<double>(entries.size());
-    const double x0 = right - box_w - 6.0;
-    const double y0 = top + 6.0;
+    const double x0 = column ? right + 6.0 : right - box_w - 6.0;
+    const double y0 = column ? top : top + 6.0;
     out += "<g class=\"lg\"><rect x=\"" + coordinate(x0) + "\" y=\"" + coordinate(y0) +
            "\" width=\"" + coordinate(box_w) + "\" height=\"" + coordinate(box_h) +
            "\" fill=\"#fff\" fill-opacity=\"0.85\" stroke=\"#ccc\"/>\n";
     for (std::size_t i = 0; i < entries.size(); ++i) {
       const double y = y0 + 12.0 + 15.0 * static_cast<double>(i);
-      const auto& [label, style] = entries[i];
-      out += "<line x1=\"" + coordinate(x0 + 6) + "\" y1=\"" + coordinate(y - 4) + "\" x2=\"" +
-             coordinate(x0 + 26) + "\" y2=\"" + coordinate(y - 4) + "\" stroke=\"" +
-             escape_html(style.first) + "\" stroke-width=\"2\"" +
-             (style.second ? " stroke-dasharray=\"6 4\"" : "") + "/><text x=\"" +
-             coordinate(x0 + 30) + "\" y=\"" + coordinate(y) + "\">" + escape_html(label) +
-             "</text>\n";
+      const Entry& e = entries[i];
+      const std::string colour = escape_html(e.colour);
+      if (e.swatch == Swatch::kFill) {
+        append(out, "<rect x=\"", coordinate(x0 + 6), "\" y=\"", coordinate(y - 9),
+               "\" width=\"20\"", " height=\"10\" fill=\"", colour, "\" fill-opacity=\"",
+               coordinate(kBandOpacity), "\"/>");
+      } else {
+        append(out, "<line x1=\"", coordinate(x0 + 6), "\" y1=\"", coordinate(y - 4), "\" x2=\"",
+               coordinate(x0 + 26), "\" y2=\"", coordinate(y - 4), "\" stroke=\"", colour,
+               "\" stroke-width=\"2\"",
+               e.swatch == Swatch::kDashed ? " stroke-dasharray=\"6 4\"" : "", "/>");
+      }
+      append(out, "<text x=\"", coordinate(x0 + 30), "\" y=\"", coordinate(y), "\">",
+             escape_html(e.label), "</text>\n");
     }
     out += "</g>\n";
   }
