@@ -24,6 +24,7 @@ void add_import_command(CLI::App& app);
 void add_check_config_command(CLI::App& app);
 void add_ctl_command(CLI::App& app);
 void add_diagnose_command(CLI::App& app);
+void add_main_job_page_command(CLI::App& app);
 void add_sim_device_command(CLI::App& app);
 
 }  // namespace selfsense::cli

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   selfsense::cli::add_check_config_command(app);
   selfsense::cli::add_ctl_command(app);
   selfsense::cli::add_diagnose_command(app);
+  selfsense::cli::add_main_job_page_command(app);
   selfsense::cli::add_sim_device_command(app);
   try {
     app.parse(argc, argv);
