@@ -115,4 +115,4 @@ if [ -z "${SELFSENSE_MAIN_JOB_CONFIG:-}" ]; then
   segments+=(undamped damped)
 fi
 trap - EXIT
-"$root/scripts/main_job_report.sh" "$out" "${segments[@]}"
+SELFSENSE_CLI=$cli "$root/scripts/main_job_report.sh" "$out" "${segments[@]}"

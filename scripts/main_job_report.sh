@@ -4,28 +4,24 @@
 # of the setpoint's range, over the settled samples (0.2 s after each setpoint step on); for the
 # damping run's segments (undamped, damped) the ring-down after the impulse: the time from the
 # largest deviation of true S (and of S_hat) from its rest to the last sample outside 5 % of that
-# deviation, the rest being the mean of the recording's last 40 %. An HTML page with an inline
-# SVG plot per segment, and the faulted runs the main job repeated (OUT_DIR/faults.txt).
+# deviation, the rest being the mean of the recording's last 40 %. The HTML page
+# (OUT_DIR/main_job.html) is written by `selfsense main-job-page` with the reports' plotting code:
+# per segment its figures line and plots with axes in s, 1e-6 of strain, MPa and kV/mm, the
+# tracking error under each run, spans outside the armed state and faults marked; and the faulted
+# runs the main job repeated (OUT_DIR/faults.txt) with the recordings they spoiled.
 # Figures count the samples of the armed state only (the recording's `state` column); each line
 # says how many others it excluded. A recording in which the loop faulted gets no figure: a line
 # naming the fault's time, cycle and faults instead, and the exit status is 1 once the page is
 # written.
 #   scripts/main_job_report.sh OUT_DIR SEGMENT...   (SEGMENT.path holds its recording's path)
+# SELFSENSE_CLI: the selfsense tool (default: build/src/cli/selfsense of this tree).
 set -euo pipefail
 out=${1:?usage: scripts/main_job_report.sh OUT_DIR SEGMENT...}
 shift
-html=$out/main_job.html
-rm -f "$out/figures.txt"
-{
-  echo '<!doctype html><html><head><meta charset="utf-8"><title>selfsense main job</title>'
-  echo '<style>body{font-family:sans-serif;margin:2em}svg{border:1px solid #ccc}</style></head><body>'
-  echo '<h1>selfsensed on the simulated transducer</h1>'
-  if [ -s "$out/faults.txt" ]; then
-    echo '<h2>faulted runs, done again</h2><ul>'
-    sed -e 's/&/\&amp;/g' -e 's/</\&lt;/g' -e 's/^/<li>/' -e 's|$|</li>|' "$out/faults.txt"
-    echo '</ul>'
-  fi
-} >"$html"
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cli=${SELFSENSE_CLI:-$root/build/src/cli/selfsense}
+[ -x "$cli" ] || { echo "FAILED: no selfsense tool at $cli (set SELFSENSE_CLI)" >&2; exit 1; }
+rm -f "$out/figures.txt" "$out/main_job.html"
 # The armed samples of a recording (awk, before the segment's own rules): `state` 2 is armed;
 # others are counted in `excluded`, the first faulted one (state 0) kept: its t, cycle, faults.
 armed_only='
@@ -52,10 +48,9 @@ armed_only='
     return 0
   }
 '
-# ring_down SEGMENT FILE: figures line on stdout, the plot (S - rest over 0.4 s from 0.05 s before
-# the peak, true S red, S_hat blue) in OUT/SEGMENT.svg.
+# ring_down SEGMENT FILE: the figures line on stdout.
 ring_down() {
-  awk -F, -v seg="$1" -v svg="$out/$1.svg" "$armed_only"'
+  awk -F, -v seg="$1" "$armed_only"'
     { n++; t[n] = $col["t"]; x[n] = $col["S"]; h[n] = $col["S_hat"] }
     function rest(v,   i, m, s) { for (i = int(0.6 * n); i <= n; i++) { s += v[i]; m++ } return s / m }
     function ring(v, base,   i, d, peak, at, last) {
@@ -63,46 +58,28 @@ ring_down() {
       for (i = 1; i <= n; i++) { d = v[i] - base; if (d < 0) d = -d; if (d > peak) { peak = d; at = i } }
       last = at
       for (i = at; i <= n; i++) { d = v[i] - base; if (d < 0) d = -d; if (d > 0.05 * peak) last = i }
-      PEAK = peak; AT = at
+      PEAK = peak
       return t[last] - t[at]
     }
     END {
       if (no_figure(seg, n)) exit 1
       bx = rest(x); bh = rest(h)
-      rh = ring(h, bh); rx = ring(x, bx); peak = PEAK; at = AT
+      rh = ring(h, bh); rx = ring(x, bx); peak = PEAK
       printf "%s: %d armed samples (%d outside the armed state excluded), peak deviation of true S %.3g, ring-down to 5 %%: true S %.1f ms, S_hat %.1f ms\n",
              seg, n, excluded, peak, 1000 * rx, 1000 * rh
-      W = 900; H = 300; t0 = t[at] - 0.05; t1 = t0 + 0.4
-      printf "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\">\n", W, H > svg
-      for (k = 1; k <= 2; k++) {
-        printf "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1\" points=\"", (k == 1) ? "#d62728" : "#1f77b4" > svg
-        for (i = 1; i <= n; i++) {
-          if (t[i] < t0 || t[i] > t1) continue
-          v = (k == 1) ? x[i] - bx : h[i] - bh
-          printf "%.1f,%.1f ", W * (t[i] - t0) / (t1 - t0), H * (0.5 - 0.45 * v / peak) > svg
-        }
-        print "\"/>" > svg
-      }
-      print "</svg>" > svg
     }' "$2"
 }
 
 faulted=0
 for segment in "$@"; do
   file=$(cat "$out/$segment.path")
-  rm -f "$out/$segment.svg"
   if [ "$segment" = undamped ] || [ "$segment" = damped ]; then
     ring_down "$segment" "$file" | tee -a "$out/figures.txt" || faulted=1
-    {
-      echo "<h2>damping run: $segment</h2><p>$(tail -1 "$out/figures.txt")</p>"
-      echo "<p>S minus its rest after a 300 N impulse of 0.5 ms, 0.4 s from 0.05 s before the peak; red: true S, blue: S_hat (the signal the loop damps)</p>"
-      [ ! -f "$out/$segment.svg" ] || cat "$out/$segment.svg"
-    } >>"$html"
     continue
   fi
-  # position: S_hat and S; force: T_hat and T.
-  if [ "$segment" = force ]; then hat=T_hat truth=T unit=Pa; else hat=S_hat truth=S unit=-; fi
-  awk -F, -v hat="$hat" -v truth="$truth" -v seg="$segment" -v unit="$unit" -v svg="$out/$segment.svg" "$armed_only"'
+  # position: S_hat and S against a strain setpoint; force: T_hat and T against a stress one.
+  if [ "$segment" = force ]; then hat=T_hat truth=T unit=' Pa'; else hat=S_hat truth=S unit=' (strain)'; fi
+  awk -F, -v hat="$hat" -v truth="$truth" -v seg="$segment" -v unit="$unit" "$armed_only"'
     { n++; t[n] = $col["t"]; r[n] = $col["setpoint"]; h[n] = $col[hat]; x[n] = $col[truth] }
     END {
       if (no_figure(seg, n)) exit 1
@@ -114,36 +91,15 @@ for segment in "$@"; do
         if (t[i] - last_jump < 0.2) continue
         m++; eh += (h[i] - r[i]) ^ 2; ex += (x[i] - r[i]) ^ 2
       }
-      printf "%s: %d armed samples (%d settled; %d outside the armed state excluded), setpoint range %.4g %s: %s %.3f %% RMS, true %s %.3f %% RMS\n",
-             seg, n, m, excluded, range, unit, hat, 100 * sqrt(eh / m) / range, truth, 100 * sqrt(ex / m) / range
-      # plot: setpoint black, estimate blue, truth red; about 1500 points
-      W = 900; H = 300; step = int(n / 1500) + 1
-      ylo = lo - 0.1 * range; yhi = hi + 0.1 * range
-      printf "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\">\n", W, H > svg
-      split("r h x", names, " "); split("black #1f77b4 #d62728", colours, " ")
-      for (k = 1; k <= 3; k++) {
-        printf "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1\" points=\"", colours[k] > svg
-        for (i = 1; i <= n; i += step) {
-          v = (k == 1) ? r[i] : (k == 2) ? h[i] : x[i]
-          printf "%.1f,%.1f ", W * (t[i] - t[1]) / (t[n] - t[1]), H * (yhi - v) / (yhi - ylo) > svg
-        }
-        print "\"/>" > svg
-      }
-      print "</svg>" > svg
+      printf "%s: %d armed samples (%d settled; %d outside the armed state excluded), setpoint range %.4g to %.4g%s: %s %.3f %% RMS, true %s %.3f %% RMS\n",
+             seg, n, m, excluded, lo, hi, unit, hat, 100 * sqrt(eh / m) / range, truth, 100 * sqrt(ex / m) / range
     }' "$file" | tee -a "$out/figures.txt" || faulted=1
-  {
-    echo "<h2>$segment</h2><p>$(tail -1 "$out/figures.txt")</p>"
-    echo "<p>black: setpoint, blue: $hat (self-sensed), red: $truth (the plant's truth, never seen by the loop)</p>"
-    [ ! -f "$out/$segment.svg" ] || cat "$out/$segment.svg"
-  } >>"$html"
 done
 if grep -q '^undamped: .* ring-down to 5' "$out/figures.txt" && grep -q '^damped: .* ring-down to 5' "$out/figures.txt"; then
   ms() { sed -n "s/^$1: .* true S \([0-9.]*\) ms, S_hat \([0-9.]*\) ms/\\$2/p" "$out/figures.txt"; }
   awk -v ux="$(ms undamped 1)" -v dx="$(ms damped 1)" -v uh="$(ms undamped 2)" -v dh="$(ms damped 2)" \
     'BEGIN { printf "damping: ring-down shortened %.1fx on true S, %.1fx on S_hat (goal 10x)\n", ux / dx, uh / dh }' |
     tee -a "$out/figures.txt"
-  echo "<p><b>$(tail -1 "$out/figures.txt")</b></p>" >>"$html"
 fi
-echo '</body></html>' >>"$html"
-echo "wrote $html"
+"$cli" main-job-page "$out" "$@" || faulted=1
 [ "$faulted" = 0 ] || { echo "a recording has faulted samples: no figure for it" >&2; exit 1; }

@@ -14,6 +14,7 @@ set -euo pipefail
 build=${1:?usage: main_job_faults.sh BUILD_DIR}
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 cli=$build/src/cli/selfsense
+export SELFSENSE_CLI=$cli  # scripts/main_job_report.sh writes the page with it
 out=$(mktemp -d)
 pid=
 cleanup() {

@@ -14,6 +14,7 @@ set -euo pipefail
 build=${1:?usage: modbus_end_to_end.sh BUILD_DIR}
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../../.." && pwd)
 cli=$build/src/cli/selfsense
+export SELFSENSE_CLI=$cli  # scripts/main_job_report.sh writes the page with it
 out=$(mktemp -d)
 config=$root/config/.e2e-modbus-$$.yaml
 device_pid= daemon_pid=
