@@ -29,7 +29,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-format clang-tidy python3  # python3: run-clang-tidy and scripts/tidy_cached.py
   clang libclang-rt-14-dev  # the sanitizer build and the fuzz targets (libFuzzer), tests/fuzz
-  zlib1g-dev chromium fonts-liberation  # the diagnosis report's browser test (tests/cli)
+  zlib1g-dev chromium fonts-liberation  # the reports' browser tests (tests/cli)
   mbpoll
   rt-tests  # cyclictest beside the loop in tests/bench/loop_timing_bench (docs/benchmarks.md)
 )
