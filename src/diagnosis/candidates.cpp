@@ -10,22 +10,6 @@
 namespace selfsense::diagnosis::detail {
 namespace {
 
-// Time since the drive last moved by more than 5 % of its range, log10 seconds.
-std::vector<double> log_time_since_step(std::span<const double> x, double ts) {
-  std::vector<double> out(x.size());
-  const double step = 0.05 * range_of(x);
-  double anchor = x.empty() ? 0.0 : x[0];
-  std::size_t since = 0;
-  for (std::size_t k = 0; k < x.size(); ++k) {
-    if (std::abs(x[k] - anchor) > step) {
-      anchor = x[k];
-      since = k;
-    }
-    out[k] = std::log10(static_cast<double>(k - since + 1) * ts);
-  }
-  return out;
-}
-
 std::vector<double> rate_of(std::span<const double> x, double ts) {
   std::vector<double> out(x.size(), 0.0);
   for (std::size_t k = 1; k < x.size(); ++k)
@@ -496,6 +480,21 @@ std::vector<CorrectionTerm> merged(const std::vector<CorrectionTerm>& a,
   std::vector<CorrectionTerm> out = a;
   for (const CorrectionTerm t : b) {
     if (std::find(out.begin(), out.end(), t) == out.end()) out.push_back(t);
+  }
+  return out;
+}
+
+std::vector<double> log_time_since_step(std::span<const double> x, double ts) {
+  std::vector<double> out(x.size());
+  const double step = 0.05 * range_of(x);
+  double anchor = x.empty() ? 0.0 : x[0];
+  std::size_t since = 0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    if (std::abs(x[k] - anchor) > step) {
+      anchor = x[k];
+      since = k;
+    }
+    out[k] = std::log10(static_cast<double>(k - since + 1) * ts);
   }
   return out;
 }

@@ -56,6 +56,10 @@ struct Candidate {
 [[nodiscard]] bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s,
                               bool has_sensed, bool charge_drive);
 
+// Time since the drive last moved by more than 5 % of its range, log10 seconds: the feature
+// creep follows.
+[[nodiscard]] std::vector<double> log_time_since_step(std::span<const double> x, double ts);
+
 // Creep keeps moving in the direction of the last step (candidates.cpp).
 [[nodiscard]] bool creep_moves_with_the_step(const ChannelCorrection& c);
 

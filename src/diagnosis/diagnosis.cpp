@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "channel_data.hpp"
 #include "held_out.hpp"
@@ -169,6 +170,7 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     };
     const auto accept_side = [&](const Reidentified& reid) {
       (ch.sensed ? result.improved.sensor : result.improved.actuator) = reid.side;
+      if (reid.structure) result.improved.structure = *reid.structure;
     };
     // A stack that warmed bends a base identified on it (its creep and loop follow the drift):
     // where the temperature moved, the channel's side is re-identified with the temperature's
@@ -178,19 +180,56 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
     if (warmed) accept_side(*warmed);
     std::vector<Finding> found;
     SearchState st = search(warmed, found);
-    // A base identified on a recording with a leak has bent its own operators to it: when the
-    // rounds name nothing on the sensed channel, the leak is judged by re-identification, and if
-    // it holds the rounds run again on the re-identified sensor side. Not where they name creep:
-    // a model without creep operators forecasts a creeping stack better with any drift, a leak
-    // included (the disc's polarization creep during holds, real.evaluate).
-    if (ch.sensed && found.empty()) {
-      std::optional<Reidentified> leak = reidentified_leak(model, s, ch, model_output, options);
-      if (leak) {
-        std::vector<Finding> again;
-        st = search(leak, again);
-        found = std::move(again);
-        accept_side(*leak);
+    bool reidentified = warmed.has_value();
+    // The rounds again on a re-identified side; `kept` goes before what they find.
+    const auto search_again = [&](const Reidentified& reid, std::vector<Finding> kept) {
+      std::vector<Finding> again;
+      st = search(reid, again);
+      kept.insert(kept.end(), std::make_move_iterator(again.begin()),
+                  std::make_move_iterator(again.end()));
+      found = std::move(kept);
+      accept_side(reid);
+      reidentified = true;
+    };
+    // A loop identified on a creeping stack bends to the creep: on a model without creep
+    // operators, where the rounds name creep or nothing on the channel, the structure with them
+    // is judged by re-identification.
+    const auto named_only = [&](std::string_view effect) {
+      return std::all_of(found.begin(), found.end(),
+                         [&](const Finding& f) { return f.effect == effect; });
+    };
+    models::TransducerModel structure = model;  // the structure the leak is judged with
+    std::vector<Finding> creep_found;
+    if (!reidentified && named_only("creep")) {
+      std::optional<Reidentified> creep = reidentified_creep(model, s, ch, model_output, options);
+      if (creep) {
+        structure.structure = *creep->structure;
+        creep_found = {creep->finding};
+        search_again(*creep, {});
       }
+    }
+    // A base identified on a recording with a leak has bent its own operators to it: when the
+    // rounds name nothing on the sensed channel (or only the creep just re-identified), the leak
+    // is judged by re-identification with the structure as it now stands, and if it holds the
+    // rounds run again on the re-identified sensor side. Not where the rounds name creep on a
+    // structure without creep operators: such a model forecasts a creeping stack better with any
+    // drift, a leak included (the disc's polarization creep during holds, real.evaluate).
+    const bool after_creep = !creep_found.empty() && named_only("creep");
+    if (ch.sensed && (found.empty() || after_creep)) {
+      std::optional<Reidentified> leak = reidentified_leak(structure, s, ch, model_output, options);
+      if (leak) search_again(*leak, creep_found);
+    }
+    // A channel sampled late bends the base the same way (its fastest lags follow the lag, so a
+    // delay fitted after it wins on fast blocks and loses on slow ones): where a lag explained
+    // min_explains of the held-out residual in the first round and the rounds named nothing
+    // but lags on the whole record, the delay is judged by re-identification.
+    const bool only_lags = std::all_of(found.begin(), found.end(), [](const Finding& f) {
+      return f.effect == "delay" || f.effect == "dynamics";
+    });
+    if (!reidentified && (st.rounds_named == 0 || only_lags) &&
+        st.lag_explains >= options.min_explains) {
+      std::optional<Reidentified> late = reidentified_delay(model, s, ch, model_output, options);
+      if (late) search_again(*late, {});
     }
     result.findings.insert(result.findings.end(), std::make_move_iterator(found.begin()),
                            std::make_move_iterator(found.end()));

@@ -13,81 +13,106 @@
 namespace selfsense::diagnosis::detail {
 namespace {
 
-// A leak, and what it costs to judge: the model identified on D with it undone.
+// An effect after the model, and what it costs to judge: the channel's side identified on the
+// channel with the effect undone.
 struct Trial {
-  models::ChannelCorrection leak{};
-  std::vector<double> forecast{};  // the identified model's D through the leak, whole record
+  models::ChannelCorrection effect{};
+  std::vector<double> forecast{};  // the identified model's channel through the effect
   double first_half_sse{std::numeric_limits<double>::infinity()};
 };
 
 class Judge {
  public:
-  Judge(const models::TransducerModel& model, const Signals& s)
-      : model_(model), s_(s), half_(s.drive.size() / 2) {}
+  Judge(const models::TransducerModel& model, const Signals& s, const ChannelData& ch)
+      : Judge(model, s, ch, model.structure) {}
+  // Identifies with another structure than the model's (the model's with creep operators).
+  Judge(const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
+        models::Structure structure)
+      : model_(model), s_(s), ch_(ch), structure_(structure), half_(s.drive.size() / 2) {}
 
   [[nodiscard]] std::size_t half() const { return half_; }
 
-  // D as the model would see it without the leak (the correction stage's inverse).
-  [[nodiscard]] std::vector<double> undone(const models::ChannelCorrection& leak) const {
-    std::vector<double> out(s_.sensed.begin(), s_.sensed.end());
-    if (leak.empty()) return out;
-    models::CorrectionStage stage(leak, s_.sample_time);
+  // The channel as the model would see it without the effect: a delay is undone by reading
+  // the record that much later (linear interpolation, the last sample held), a leak by the
+  // correction stage's inverse.
+  [[nodiscard]] std::vector<double> undone(const models::ChannelCorrection& effect) const {
+    const std::span<const double> x = ch_.recorded;
+    std::vector<double> out(x.begin(), x.end());
+    if (effect.empty()) return out;
+    if (effect.delay_s > 0.0) {
+      const double samples = effect.delay_s / s_.sample_time;
+      for (std::size_t k = 0; k < out.size(); ++k) {
+        const double p = static_cast<double>(k) + samples;
+        const auto i = static_cast<std::size_t>(std::floor(p));
+        const double f = p - std::floor(p);
+        out[k] = i + 1 < x.size() ? x[i] + f * (x[i + 1] - x[i]) : x.back();
+      }
+      return out;
+    }
+    models::CorrectionStage stage(effect, s_.sample_time);
     for (std::size_t k = 0; k < out.size(); ++k) {
       models::CorrectionStage::Inputs in;
       in.drive = s_.drive[k];
-      out[k] = stage.invert(s_.sensed[k], in);
+      out[k] = stage.invert(x[k], in);
     }
     return out;
   }
 
-  // The structure's sensor side identified on D with the leak undone over `samples` samples;
-  // its D over the whole record.
-  [[nodiscard]] models::TransducerModel identify(const std::vector<double>& d,
+  // The structure's side of this channel identified on `y` over its first `samples` samples.
+  [[nodiscard]] models::TransducerModel identify(const std::vector<double>& y,
                                                  std::size_t samples) const {
     const auto first = [samples](std::span<const double> x) {
       return x.empty() ? x : x.first(samples);
     };
     identification::TransducerSignals t;
     t.drive = first(s_.drive);
-    t.sensed = std::span<const double>(d).first(samples);
+    (ch_.sensed ? t.sensed : t.strain) = std::span<const double>(y).first(samples);
     t.stress = first(s_.stress);
     t.sample_time = s_.sample_time;
-    return identification::identify(t, model_.structure,
-                                    identification::defaults_for(model_.structure));
+    return identification::identify(t, structure_, identification::defaults_for(structure_));
   }
 
+  // The identified model's channel over the whole record, through the effect.
   [[nodiscard]] std::vector<double> forecast(const models::TransducerModel& m,
-                                             const models::ChannelCorrection& leak) const {
-    std::vector<double> d = simulate(m, s_).sensed;
-    static_cast<void>(hold_finite(d));
-    if (leak.empty()) return d;
+                                             const models::ChannelCorrection& effect) const {
+    const Outputs o = simulate(m, s_);
+    std::vector<double> y = ch_.sensed ? o.sensed : o.strain;
+    static_cast<void>(hold_finite(y));
+    if (effect.empty()) return y;
     identification::CorrectionSignals cs;
-    cs.y = d;
+    cs.y = y;
     cs.drive = s_.drive;
     cs.sample_time = s_.sample_time;
-    return identification::apply_correction(cs, leak);
+    return identification::apply_correction(cs, effect);
   }
 
-  [[nodiscard]] Trial trial(const models::ChannelCorrection& leak) const {
+  [[nodiscard]] Trial trial(const models::ChannelCorrection& effect) const {
     Trial t;
-    t.leak = leak;
+    t.effect = effect;
     try {
-      t.forecast = forecast(identify(undone(leak), half_), leak);
+      t.forecast = forecast(identify(undone(effect), half_), effect);
     } catch (const std::invalid_argument&) {
-      return t;  // no identification with this leak undone: not a candidate
+      return t;  // no identification with this effect undone: not a candidate
     }
     double sse = 0.0;
     for (std::size_t k = 0; k < half_; ++k) {
-      const double e = s_.sensed[k] - t.forecast[k];
+      const double e = ch_.recorded[k] - t.forecast[k];
       sse += e * e;
     }
     if (std::isfinite(sse)) t.first_half_sse = sse;
     return t;
   }
 
+  [[nodiscard]] const std::optional<models::SideModel>& side_of(
+      const models::TransducerModel& m) const {
+    return ch_.sensed ? m.sensor : m.actuator;
+  }
+
  private:
   const models::TransducerModel& model_;
   const Signals& s_;
+  const ChannelData& ch_;
+  models::Structure structure_;
   std::size_t half_;
 };
 
@@ -128,13 +153,12 @@ models::ChannelCorrection scaled(models::ChannelCorrection c, double factor) {
   return c;
 }
 
-const Candidate& leak_candidate(const models::ChannelCorrection& leak) {
-  const CorrectionTerm term =
-      leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage : CorrectionTerm::kDriveIntegral;
+// The first candidate that carries `term`.
+const Candidate& candidate_using(CorrectionTerm term) {
   for (const Candidate& c : candidates()) {
     if (uses_term(c, term)) return c;
   }
-  throw std::logic_error("reidentified_leak: no candidate for the leak");
+  throw std::logic_error("reidentified: no candidate carries the term");
 }
 
 }  // namespace
@@ -168,74 +192,203 @@ std::vector<Segment> where_it_changes(const std::vector<double>& output,
   return where;
 }
 
-std::optional<Reidentified> reidentified_leak(const models::TransducerModel& model,
-                                              const Signals& s, const ChannelData& ch,
-                                              const std::vector<double>& current,
-                                              const Options& options) {
-  const std::size_t n = s.drive.size();
-  if (!ch.sensed || model.drive() != models::Drive::kField || model.vectorial || !model.sensor ||
-      s.sensed.size() != n || n < 1000) {
-    return std::nullopt;
-  }
-  // Without T the re-identified sensor side would lose the model's stress coupling.
-  if (ch.coupling != 0.0 && s.stress.empty()) return std::nullopt;
-  const Judge judge(model, s);
-  const Trial null = judge.trial(models::ChannelCorrection{});
-  if (null.forecast.empty()) return std::nullopt;
+namespace {
 
-  Trial best;
-  for (const models::ChannelCorrection& leak : coarse_leaks(s)) {
-    Trial t = judge.trial(leak);
-    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
-  }
-  if (best.forecast.empty()) return std::nullopt;
-  for (const double factor : {std::sqrt(3.0), 1.0 / std::sqrt(3.0)}) {
-    Trial t = judge.trial(scaled(best.leak, factor));
-    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
-  }
-  // The leak must be the structure's own finding too: with it undone the identification fits
-  // the first half by min_explains better (on clean stacks a small leak of either sign mends
-  // the forecast of a model of another class a little; it does not change the fit).
-  if (best.forecast.empty() ||
+// The forecast's judgement of `best` against `null` (both identified on the first half): it
+// must fit that half by min_explains better (the identification's own evidence: on clean stacks
+// a small effect mends the forecast of a model of another class a little; it does not change the
+// fit) and beat the null on the second half by the rules of a round. The share of the null's
+// error it removes there, or nullopt.
+std::optional<double> forecast_explains(const Trial& null, const Trial& best, const ChannelData& ch,
+                                        std::size_t half, const Options& options) {
+  if (null.forecast.empty() || best.forecast.empty() ||
       1.0 - best.first_half_sse / null.first_half_sse < options.min_explains) {
     return std::nullopt;
   }
-
-  const Rows rows = forecast_rows(n, judge.half(), options.blocks, null.forecast, best.forecast);
+  const Rows rows =
+      forecast_rows(ch.recorded.size(), half, options.blocks, null.forecast, best.forecast);
   const double null_sse = sse_over(ch.recorded, null.forecast, rows.judge);
-  const double leak_sse = sse_over(ch.recorded, best.forecast, rows.judge);
+  const double best_sse = sse_over(ch.recorded, best.forecast, rows.judge);
   if (!(null_sse > 0.0)) return std::nullopt;
-  const double explains = 1.0 - leak_sse / null_sse;
+  const double explains = 1.0 - best_sse / null_sse;
   if (explains < options.min_explains ||
       !passes_blocks(block_explains(ch.recorded, null.forecast, best.forecast, rows), options)) {
     return std::nullopt;
   }
+  return explains;
+}
 
+// The improved side: identified on the whole record with the effect undone.
+std::optional<Reidentified> identified_whole(const Judge& judge,
+                                             const models::ChannelCorrection& effect,
+                                             const ChannelData& ch, double explains) {
   Reidentified r;
-  r.correction = best.leak;
+  r.correction = effect;
   try {
-    const models::TransducerModel whole = judge.identify(judge.undone(best.leak), n);
-    if (!whole.sensor) return std::nullopt;
-    r.side = *whole.sensor;
+    const models::TransducerModel whole = judge.identify(judge.undone(effect), ch.recorded.size());
+    const std::optional<models::SideModel>& side = judge.side_of(whole);
+    if (!side) return std::nullopt;
+    r.side = *side;
     r.base = judge.forecast(whole, models::ChannelCorrection{});
-    r.output = judge.forecast(whole, best.leak);
+    r.output = judge.forecast(whole, effect);
   } catch (const std::invalid_argument&) {
     return std::nullopt;
   }
-  Finding& f = r.finding;
-  f.effect = "charge_leakage";
-  f.channel = ch.name;
-  f.explains = explains;
-  f.where = where_it_changes(r.output, current);
-  const std::string judged = format(
-      "on the last %.3g s of the recording as a forecast (the model's structure identified on "
-      "the first half with the leak undone, against the same structure identified on D as "
-      "recorded: the model had bent its own operators to the leak)",
-      static_cast<double>(n - judge.half()) * s.sample_time);
-  r.candidate = &leak_candidate(best.leak);
-  r.terms = {best.leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage
-                                           : CorrectionTerm::kDriveIntegral};
-  describe(f, *r.candidate, best.leak, ch, s, current, r.output, judged);
+  r.finding.channel = ch.name;
+  r.finding.explains = explains;
+  return r;
+}
+
+// One family of effects judged as a forecast: the effect chosen on the first half's fit (a
+// coarse grid, then `refine`'s neighbours of the best), judged by forecast_explains.
+template <typename Refine>
+std::optional<Reidentified> judged_as_forecast(const Judge& judge, const ChannelData& ch,
+                                               const std::vector<models::ChannelCorrection>& grid,
+                                               Refine&& refine, const Options& options) {
+  const Trial null = judge.trial(models::ChannelCorrection{});
+  if (null.forecast.empty()) return std::nullopt;
+  Trial best;
+  for (const models::ChannelCorrection& effect : grid) {
+    Trial t = judge.trial(effect);
+    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
+  }
+  if (best.forecast.empty()) return std::nullopt;
+  for (const models::ChannelCorrection& effect : refine(best.effect)) {
+    Trial t = judge.trial(effect);
+    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
+  }
+  const std::optional<double> explains = forecast_explains(null, best, ch, judge.half(), options);
+  if (!explains) return std::nullopt;
+  return identified_whole(judge, best.effect, ch, *explains);
+}
+
+// The model and recording allow a side to be re-identified on this channel.
+bool reidentifiable(const models::TransducerModel& model, const Signals& s, const ChannelData& ch) {
+  const std::size_t n = s.drive.size();
+  const bool has_side = ch.sensed ? model.sensor.has_value() : model.actuator.has_value();
+  if (model.drive() != models::Drive::kField || model.vectorial || !has_side ||
+      ch.recorded.size() != n || n < 1000) {
+    return false;
+  }
+  // Without T the re-identified side would lose the model's stress coupling.
+  return ch.coupling == 0.0 || !s.stress.empty();
+}
+
+std::string as_forecast(const Judge& judge, const Signals& s, const ChannelData& ch,
+                        const std::string& effect) {
+  return format(
+             "on the last %.3g s of the recording as a forecast (the model's structure "
+             "identified on the first half with the ",
+             static_cast<double>(s.drive.size() - judge.half()) * s.sample_time) +
+         effect + " undone, against the same structure identified on " + ch.name +
+         " as recorded: the model had bent its own operators to the " + effect + ")";
+}
+
+// The creep operators' time constants, for the evidence: "lags of 0.01-100 s".
+std::string lags_of(const models::SideModel& side) {
+  const std::vector<double>& lambda = side.op.creep.eigenvalues;
+  if (lambda.empty()) return "no lags";
+  const auto [lo, hi] = std::minmax_element(lambda.begin(), lambda.end());
+  return format("%zu lags of ", static_cast<double>(lambda.size())) + format("%.2g-", 1.0 / *hi) +
+         format("%.2g s", 1.0 / *lo);
+}
+
+}  // namespace
+
+std::optional<Reidentified> reidentified_leak(const models::TransducerModel& model,
+                                              const Signals& s, const ChannelData& ch,
+                                              const std::vector<double>& current,
+                                              const Options& options) {
+  if (!ch.sensed || !reidentifiable(model, s, ch)) return std::nullopt;
+  const Judge judge(model, s, ch);
+  const auto neighbours = [](const models::ChannelCorrection& c) {
+    return std::vector<models::ChannelCorrection>{scaled(c, std::sqrt(3.0)),
+                                                  scaled(c, 1.0 / std::sqrt(3.0))};
+  };
+  std::optional<Reidentified> r =
+      judged_as_forecast(judge, ch, coarse_leaks(s), neighbours, options);
+  if (!r) return std::nullopt;
+  const models::ChannelCorrection& leak = r->correction;
+  r->candidate = &candidate_using(leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage
+                                                           : CorrectionTerm::kDriveIntegral);
+  r->terms = {leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage : CorrectionTerm::kDriveIntegral};
+  r->finding.effect = "charge_leakage";
+  r->finding.where = where_it_changes(r->output, current);
+  describe(r->finding, *r->candidate, leak, ch, s, current, r->output,
+           as_forecast(judge, s, ch, "leak"));
+  return r;
+}
+
+std::optional<Reidentified> reidentified_delay(const models::TransducerModel& model,
+                                               const Signals& s, const ChannelData& ch,
+                                               const std::vector<double>& current,
+                                               const Options& options) {
+  if (!reidentifiable(model, s, ch)) return std::nullopt;
+  const Judge judge(model, s, ch);
+  const double most = static_cast<double>(models::kMaxCorrectionDelaySamples) * s.sample_time;
+  const auto delay = [&](double seconds) {
+    models::ChannelCorrection c;
+    c.delay_s = std::min(seconds, most);
+    return c;
+  };
+  // A quarter of a sample to 16 samples, doubling; then the best one's neighbours at a factor
+  // 2^(1/2) and, around the better of those, 2^(1/4).
+  std::vector<models::ChannelCorrection> grid;
+  for (int doubling = -2; doubling <= 4; ++doubling)
+    grid.push_back(delay(std::ldexp(s.sample_time, doubling)));
+  const auto neighbours = [&](const models::ChannelCorrection& c) {
+    std::vector<models::ChannelCorrection> out;
+    for (const double f : {std::sqrt(2.0), 1.0 / std::sqrt(2.0), std::pow(2.0, 0.25),
+                           std::pow(2.0, -0.25), std::pow(2.0, 0.75), std::pow(2.0, -0.75)}) {
+      out.push_back(delay(c.delay_s * f));
+    }
+    return out;
+  };
+  std::optional<Reidentified> r = judged_as_forecast(judge, ch, grid, neighbours, options);
+  if (!r) return std::nullopt;
+  r->candidate = &candidate_using(CorrectionTerm::kDelay);
+  r->terms = {CorrectionTerm::kDelay};
+  r->finding.effect = r->candidate->effect;
+  r->finding.where = where_it_changes(r->output, current);
+  describe(r->finding, *r->candidate, r->correction, ch, s, current, r->output,
+           as_forecast(judge, s, ch, "delay"));
+  return r;
+}
+
+std::optional<Reidentified> reidentified_creep(const models::TransducerModel& model,
+                                               const Signals& s, const ChannelData& ch,
+                                               const std::vector<double>& current,
+                                               const Options& options) {
+  if (model.structure != models::Structure::kHysteresis || !reidentifiable(model, s, ch)) {
+    return std::nullopt;
+  }
+  constexpr models::Structure kWithCreep = models::Structure::kHysteresisCreep;
+  const Judge as_is(model, s, ch);
+  const Judge with_creep(model, s, ch, kWithCreep);
+  const Trial null = as_is.trial(models::ChannelCorrection{});
+  const Trial creep = with_creep.trial(models::ChannelCorrection{});
+  const std::optional<double> explains = forecast_explains(null, creep, ch, as_is.half(), options);
+  if (!explains) return std::nullopt;
+  std::optional<Reidentified> r =
+      identified_whole(with_creep, models::ChannelCorrection{}, ch, *explains);
+  if (!r) return std::nullopt;
+  r->structure = kWithCreep;
+  r->candidate = &candidate_using(CorrectionTerm::kCreep);
+  Finding& f = r->finding;
+  f.effect = r->candidate->effect;
+  f.where = where_it_changes(r->output, current);
+  f.evidence = "after steps of the drive the recorded " + ch.name +
+               " keeps moving, as creep operators draw it (the model's structure with them, " +
+               std::string(models::to_string(kWithCreep)) + ": " + lags_of(r->side) +
+               format("); modelled, it removes %.0f %% of the residual variance on the last ",
+                      100.0 * *explains) +
+               format(
+                   "%.3g s of the recording as a forecast (the structure with creep operators "
+                   "identified on the first half, against the same structure without them: the "
+                   "model had bent its loop to the creep)",
+                   static_cast<double>(s.drive.size() - as_is.half()) * s.sample_time);
+  f.feature_name = "log10 time since the drive last stepped [s]";
+  f.feature = log_time_since_step(s.drive, s.sample_time);
   return r;
 }
 

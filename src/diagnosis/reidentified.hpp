@@ -43,6 +43,9 @@ struct Reidentified {
   const Candidate* candidate{nullptr};                // its candidate (named once per channel)
   std::vector<double> base{};                         // the re-identified side's output
   std::vector<double> output{};                       // ... through the effect
+  // The structure the side was identified with, when it is not the model's (creep operators
+  // added to a hysteresis model).
+  std::optional<models::Structure> structure{};
 };
 
 // Rows of a forecast: the first `half` samples fit, the rest judges in `judging` blocks (the odd
@@ -62,6 +65,30 @@ struct Reidentified {
                                                             const Signals& s, const ChannelData& ch,
                                                             const std::vector<double>& current,
                                                             const Options& options);
+
+// Creep judged the same way where the model has no creep operators (a `hysteresis` model): a
+// loop identified on a creeping stack bends to the creep, and lags added after it carry little
+// to new excitation. The null is the model's structure identified on the first half, the
+// candidate the same with creep operators (hysteresis-creep); the improved model carries that
+// side (the model's structure becomes hysteresis-creep, the other side unchanged, its creep
+// operators none).
+[[nodiscard]] std::optional<Reidentified> reidentified_creep(const models::TransducerModel& model,
+                                                             const Signals& s,
+                                                             const ChannelData& ch,
+                                                             const std::vector<double>& current,
+                                                             const Options& options);
+
+// A delay on either channel judged the same way (docs/diagnose.md, "Delay re-identified"): a
+// base identified on a channel sampled late bends its fastest creep lags to the lag, and a delay
+// fitted after it then doubles what they already imitate where the drive is slow. The channel is
+// read that much later (the delay undone) for the identification; the delay is chosen on the
+// first half's fit over a quarter of a sample to 16 samples and judged as a forecast like the
+// leak.
+[[nodiscard]] std::optional<Reidentified> reidentified_delay(const models::TransducerModel& model,
+                                                             const Signals& s,
+                                                             const ChannelData& ch,
+                                                             const std::vector<double>& current,
+                                                             const Options& options);
 
 }  // namespace selfsense::diagnosis::detail
 

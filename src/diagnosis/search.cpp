@@ -66,6 +66,14 @@ void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>&
       }
     }
     if (tried.empty()) break;
+    if (round == 0) {
+      for (const Tried& t : tried) {
+        if (uses_term(*t.candidate, CorrectionTerm::kDelay) ||
+            uses_term(*t.candidate, CorrectionTerm::kDynamics)) {
+          st.lag_explains = std::max(st.lag_explains, t.explains);
+        }
+      }
+    }
     std::sort(tried.begin(), tried.end(),
               [](const Tried& a, const Tried& b) { return a.explains > b.explains; });
     // The held-out holds judge a hysteresis operator only when it would be named or listed
@@ -151,6 +159,7 @@ void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>&
     st.accepted_terms = merged(st.accepted_terms, best.candidate->terms);
     st.accepted = best.fit.correction;
     st.used.push_back(best.candidate);
+    ++st.rounds_named;
     st.current = best.fit.output;
     st.current_sse = sse_over(in.ch.recorded, st.current, in.rows.judge);
   }

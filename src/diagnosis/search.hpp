@@ -30,8 +30,12 @@ struct SearchState {
   ChannelCorrection accepted{};
   std::vector<double> current{};  // the output with the accepted corrections
   std::vector<const Candidate*> used{};
-  double current_sse{0.0};   // on the held-out blocks
-  double original_sse{0.0};  // of the model's own output there
+  double current_sse{0.0};      // on the held-out blocks
+  double original_sse{0.0};     // of the model's own output there
+  std::size_t rounds_named{0};  // findings of search_rounds (whole-record, held-out blocks)
+  // The most a lag (delay or mode) explained of the held-out residual in the first round,
+  // significant or not: the evidence that decides whether a delay is worth re-identifying.
+  double lag_explains{0.0};
 };
 
 // Rounds of candidates until none is significant (or options.max_effects): findings appended.
