@@ -125,7 +125,9 @@ TEST(DaemonConfig, ModelAndDriverProblemsAreNamed) {
       load(write("model", sim_with("model: models/sim.yaml", "model: models/none.yaml")));
   EXPECT_TRUE(has(missing, "model: ")) << missing.problems.front();
   const ConfigResult driver = load(write("driver", sim_with("type: simulated", "type: ethercat")));
-  EXPECT_TRUE(has(driver, "driver.type: 'ethercat' is not one of simulated"));
+  EXPECT_TRUE(has(
+      driver, "driver.type: 'ethercat' is not one of simulated, can, modbus-tcp, modbus-rtu, spi"))
+      << driver.problems.front();
   const ConfigResult mode = load(write("mode", sim_with("mode: position", "mode: speed")));
   EXPECT_TRUE(has(mode, "control.mode: 'speed' is not one of position, force, open-loop, damping"));
   const ConfigResult version = load(write("version", sim_with("selfsensed: 1", "selfsensed: 2")));
