@@ -10,11 +10,12 @@
 #include <string>
 
 #include "registry/registry.hpp"
+#include "support/config_edits.hpp"
 
 namespace selfsense::daemon {
 namespace {
 
-const std::filesystem::path kConfigDir = std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config";
+const std::filesystem::path kConfigDir = test::shipped_config_dir();
 
 // sim.yaml shows every key of the daemon's own; the loader also asks for the absent ones.
 DaemonConfig load_shipped(const char* name, std::set<std::string>* known = nullptr) {
