@@ -1,4 +1,4 @@
-#include "can/can_driver.hpp"
+#include "selfsense/drivers/can/can_driver.hpp"
 
 #include <linux/can/error.h>
 #include <linux/can/raw.h>

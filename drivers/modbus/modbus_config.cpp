@@ -1,4 +1,4 @@
-#include "modbus/modbus_config.hpp"
+#include "selfsense/drivers/modbus/modbus_config.hpp"
 
 #include <cmath>
 

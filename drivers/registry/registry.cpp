@@ -1,4 +1,4 @@
-#include "registry/registry.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 
 #include <array>
 #include <cmath>
@@ -6,12 +6,12 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "can/can_driver.hpp"
-#include "modbus/modbus_driver.hpp"
+#include "selfsense/drivers/can/can_driver.hpp"
+#include "selfsense/drivers/modbus/modbus_driver.hpp"
+#include "selfsense/drivers/sim/simulated_transducer.hpp"
+#include "selfsense/drivers/spi/spi_driver.hpp"
 #include "selfsense/io/yaml_map.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
-#include "sim/simulated_transducer.hpp"
-#include "spi/spi_driver.hpp"
 
 namespace selfsense::drivers {
 

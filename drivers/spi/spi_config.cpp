@@ -1,4 +1,4 @@
-#include "spi/spi_config.hpp"
+#include "selfsense/drivers/spi/spi_config.hpp"
 
 #include <cmath>
 

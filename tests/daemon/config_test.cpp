@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include "registry/registry.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 #include "support/config_edits.hpp"
 
 namespace selfsense::daemon {

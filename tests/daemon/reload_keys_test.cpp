@@ -9,7 +9,7 @@
 #include <set>
 #include <string>
 
-#include "registry/registry.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 #include "support/config_edits.hpp"
 
 namespace selfsense::daemon {

@@ -9,9 +9,9 @@
 #include <utility>
 #include <vector>
 
-#include "can/can_driver.hpp"
-#include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
+#include "selfsense/drivers/can/can_driver.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 #include "support/config_edits.hpp"
 
 namespace {

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
-#include "sim/simulated_transducer.hpp"
 #include "support/daemon_plant.hpp"
 #include "support/shipped_model.hpp"
 

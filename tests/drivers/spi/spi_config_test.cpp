@@ -8,9 +8,9 @@
 #include <utility>
 #include <vector>
 
-#include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
-#include "spi/spi_driver.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
+#include "selfsense/drivers/spi/spi_driver.hpp"
 #include "support/config_edits.hpp"
 
 namespace {

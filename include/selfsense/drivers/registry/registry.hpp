@@ -7,22 +7,22 @@
 //     plant: PATH       a plant configuration (config/plant/), relative to the daemon's file
 //   type: can           SocketCAN (drivers/can, docs/drivers/can.md)
 //     interface, fd, rx_timeout_ms, stale_cycles, error_frames, signals: {e, d, s_ref, t_ref,
-//     command}          see drivers/can/can_config.hpp
+//     command}          see include/selfsense/drivers/can/can_config.hpp
 //   type: modbus-tcp | modbus-rtu   the Modbus driver (drivers/modbus, docs/drivers/modbus.md)
 //   type: spi           ADS131M04 ADC + DAC8563 DAC on spidev, GPIO on libgpiod (drivers/spi,
-//                       docs/drivers/spi.md; keys in drivers/spi/spi_config.hpp)
+//                       docs/drivers/spi.md; keys in include/selfsense/drivers/spi/spi_config.hpp)
 #pragma once
 
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "can/can_config.hpp"
-#include "modbus/modbus_config.hpp"
 #include "selfsense/daemon/config.hpp"
+#include "selfsense/drivers/can/can_config.hpp"
+#include "selfsense/drivers/modbus/modbus_config.hpp"
+#include "selfsense/drivers/spi/spi_config.hpp"
 #include "selfsense/plant/config.hpp"
 #include "selfsense/runtime/driver.hpp"
-#include "spi/spi_config.hpp"
 
 namespace selfsense::drivers {
 
