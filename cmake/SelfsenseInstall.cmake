@@ -15,8 +15,6 @@ foreach(_target IN LISTS SELFSENSE_EXPORTED_TARGETS)
   endif()
 endforeach()
 install(DIRECTORY include/selfsense DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT dev)
-install(DIRECTORY drivers/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/selfsense/drivers
-  COMPONENT dev FILES_MATCHING PATTERN "*.hpp")
 install(TARGETS ${_selfsense_programs} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 install(TARGETS ${_selfsense_libraries} selfsense_build_flags
   EXPORT selfsenseTargets

@@ -1,4 +1,4 @@
-#include "can/can_codec.hpp"
+#include "selfsense/drivers/can/can_codec.hpp"
 
 #include <array>
 #include <cmath>

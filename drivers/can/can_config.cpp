@@ -1,4 +1,4 @@
-#include "can/can_config.hpp"
+#include "selfsense/drivers/can/can_config.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "can/can_driver.hpp"
+#include "selfsense/drivers/can/can_driver.hpp"
 
 #include <linux/can/error.h>
 #include <linux/can/raw.h>
@@ -19,6 +19,8 @@
 #include <utility>
 #include <vector>
 
+#include "selfsense/base/errno_text.hpp"
+
 namespace selfsense::drivers::can {
 namespace {
 
@@ -33,7 +35,7 @@ canid_t wire_id(const FrameId& f) noexcept {
 }
 
 std::string errno_text(const char* what) {
-  return std::string(what) + ": " + std::strerror(errno);
+  return std::string(what) + ": " + base::errno_text(errno);
 }
 
 void bump(std::atomic<std::uint64_t>& c) noexcept {

@@ -1,15 +1,13 @@
-#include "modbus/modbus_config.hpp"
+#include "selfsense/drivers/modbus/modbus_config.hpp"
 
 #include <cmath>
 
-#include "selfsense/operators/parameter_error.hpp"
+#include "selfsense/base/format_number.hpp"
 
 namespace selfsense::drivers::modbus {
 namespace {
 
-std::string number(double x) {
-  return operators::format_number(x);
-}
+using base::format_number;
 
 }  // namespace
 
@@ -91,20 +89,21 @@ std::vector<std::string> ModbusConfig::problems() const {
   }
   check(unit_id >= 1 && unit_id <= 247,
         "unit_id: " + std::to_string(unit_id) + " must be within [1, 247]");
-  check(response_timeout_s >= 1e-4 && response_timeout_s <= 10.0,
-        "response_timeout_s: " + number(response_timeout_s) + " must be within [0.0001, 10]");
+  check(
+      response_timeout_s >= 1e-4 && response_timeout_s <= 10.0,
+      "response_timeout_s: " + format_number(response_timeout_s) + " must be within [0.0001, 10]");
   check(byte_timeout_s >= 1e-4 && byte_timeout_s <= 10.0,
-        "byte_timeout_s: " + number(byte_timeout_s) + " must be within [0.0001, 10]");
+        "byte_timeout_s: " + format_number(byte_timeout_s) + " must be within [0.0001, 10]");
   check(poll_rate_hz == 0.0 || (poll_rate_hz >= 1.0 && poll_rate_hz <= 100000.0),
-        "poll_rate_hz: " + number(poll_rate_hz) +
+        "poll_rate_hz: " + format_number(poll_rate_hz) +
             " must be 0 (the loop's rate) or within [1, 100000]");
   check(priority >= 0 && priority <= 99,
         "priority: " + std::to_string(priority) + " must be 0 (normal) or within [1, 99]");
   check(max_age_s == 0.0 || (max_age_s >= 1e-5 && max_age_s <= sample_timeout_s),
-        "max_age_s: " + number(max_age_s) +
+        "max_age_s: " + format_number(max_age_s) +
             " must be 0 (2.5 poll periods) or within [0.00001, sample_timeout_s]");
   check(sample_timeout_s > 0.0 && sample_timeout_s <= 10.0,
-        "sample_timeout_s: " + number(sample_timeout_s) + " must be within (0, 10]");
+        "sample_timeout_s: " + format_number(sample_timeout_s) + " must be within (0, 10]");
   check(reconnect_min_s > 0.0 && reconnect_min_s <= reconnect_max_s && reconnect_max_s <= 60.0,
         "reconnect: min_s and max_s must satisfy 0 < min_s <= max_s <= 60");
   check(reconnect_after_failures >= 1 && reconnect_after_failures <= 1000,

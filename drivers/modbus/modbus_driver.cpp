@@ -1,4 +1,4 @@
-#include "modbus/modbus_driver.hpp"
+#include "selfsense/drivers/modbus/modbus_driver.hpp"
 
 #include <modbus.h>
 #include <pthread.h>

@@ -1,4 +1,4 @@
-#include "modbus/register_map.hpp"
+#include "selfsense/drivers/modbus/register_map.hpp"
 
 #include <bit>
 #include <cmath>

@@ -1,16 +1,29 @@
-#include "registry/registry.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 
+#include <array>
+#include <cmath>
 #include <exception>
 #include <stdexcept>
+#include <string_view>
 
-#include "can/can_driver.hpp"
-#include "modbus/modbus_driver.hpp"
+#include "selfsense/drivers/can/can_driver.hpp"
+#include "selfsense/drivers/modbus/modbus_driver.hpp"
+#include "selfsense/drivers/sim/simulated_transducer.hpp"
+#include "selfsense/drivers/spi/spi_driver.hpp"
 #include "selfsense/io/yaml_map.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
-#include "sim/simulated_transducer.hpp"
-#include "spi/spi_driver.hpp"
 
 namespace selfsense::drivers {
+
+// One row per driver.type: how its section is read and how its driver is built. driver_types()
+// (and with it the unknown-type message), read() and create() all follow this table.
+struct DriverEntry {
+  std::string_view name{};
+  void (*read)(io::YamlMap& driver, const daemon::DaemonConfig& config, DriverSections& sections,
+               std::vector<std::string>& problems){};
+  std::unique_ptr<runtime::Driver> (*create)(const DriverSections& sections){};
+};
+
 namespace {
 
 void read_simulated(io::YamlMap& driver, const daemon::DaemonConfig& config,
@@ -43,42 +56,82 @@ void read_simulated(io::YamlMap& driver, const daemon::DaemonConfig& config,
   }
 }
 
+template <modbus::Transport kTransport>
+void read_modbus(io::YamlMap& driver, const daemon::DaemonConfig& /*config*/,
+                 DriverSections& sections, std::vector<std::string>& problems) {
+  modbus::read_modbus_section(driver, kTransport, sections.modbus, problems);
+}
+
+std::unique_ptr<runtime::Driver> create_modbus(const DriverSections& sections) {
+  return std::make_unique<modbus::ModbusDriver>(sections.modbus);
+}
+
+const std::array<DriverEntry, 5> kDrivers{{
+    {"simulated",
+     [](io::YamlMap& driver, const daemon::DaemonConfig& config, DriverSections& sections,
+        std::vector<std::string>& problems) {
+       read_simulated(driver, config, sections.plant, problems);
+     },
+     [](const DriverSections& sections) -> std::unique_ptr<runtime::Driver> {
+       return std::make_unique<SimulatedTransducer>(sections.plant);
+     }},
+    {"can",
+     [](io::YamlMap& driver, const daemon::DaemonConfig& config, DriverSections& sections,
+        std::vector<std::string>& problems) {
+       sections.can = can::CanConfig{};
+       can::read_can_config(driver, config.loop.rate_hz, sections.can, problems);
+     },
+     [](const DriverSections& sections) -> std::unique_ptr<runtime::Driver> {
+       return std::make_unique<can::CanDriver>(sections.can);
+     }},
+    {"modbus-tcp", read_modbus<modbus::Transport::kTcp>, create_modbus},
+    {"modbus-rtu", read_modbus<modbus::Transport::kRtu>, create_modbus},
+    {"spi",
+     [](io::YamlMap& driver, const daemon::DaemonConfig& config, DriverSections& sections,
+        std::vector<std::string>& problems) {
+       spi::read_spi_config(driver, config.loop.rate_hz, sections.spi, problems);
+     },
+     [](const DriverSections& sections) -> std::unique_ptr<runtime::Driver> {
+       return std::make_unique<spi::SpiDriver>(sections.spi);
+     }},
+}};
+
 }  // namespace
 
 std::string driver_types() {
-  return "simulated, can, modbus-tcp, modbus-rtu, spi";
+  std::string names;
+  for (const DriverEntry& entry : kDrivers) {
+    if (!names.empty()) names += ", ";
+    names += entry.name;
+  }
+  return names;
 }
+
+Registry::Registry() = default;
+Registry::~Registry() = default;
 
 void Registry::read(io::YamlMap& driver, const daemon::DaemonConfig& config,
                     std::vector<std::string>& problems) {
-  type_ = config.driver_type;
-  const std::size_t before = problems.size();
-  if (type_ == "simulated") {
-    read_simulated(driver, config, plant_, problems);
-  } else if (type_ == "can") {
-    can_ = can::CanConfig{};
-    can::read_can_config(driver, config.loop.rate_hz, can_, problems);
-  } else if (type_ == "modbus-tcp" || type_ == "modbus-rtu") {
-    modbus::read_modbus_section(
-        driver, type_ == "modbus-tcp" ? modbus::Transport::kTcp : modbus::Transport::kRtu, modbus_,
-        problems);
-  } else if (type_ == "spi") {
-    spi::read_spi_config(driver, config.loop.rate_hz, spi_, problems);
-  } else {
-    problems.push_back(
-        driver.locate("driver.type: '" + type_ + "' is not one of " + driver_types()));
+  entry_ = nullptr;
+  for (const DriverEntry& entry : kDrivers) {
+    if (entry.name == config.driver_type) entry_ = &entry;
   }
+  if (entry_ == nullptr) {
+    problems.push_back(
+        driver.locate("driver.type: '" + config.driver_type + "' is not one of " + driver_types()));
+    ok_ = false;
+    return;
+  }
+  const std::size_t before = problems.size();
+  entry_->read(driver, config, sections_, problems);
   ok_ = problems.size() == before;
 }
 
 std::unique_ptr<runtime::Driver> Registry::create() const {
-  if (!ok_) throw std::logic_error("driver registry: no valid driver section was read");
-  if (type_ == "can") return std::make_unique<can::CanDriver>(can_);
-  if (type_ == "spi") return std::make_unique<spi::SpiDriver>(spi_);
-  if (type_ == "modbus-tcp" || type_ == "modbus-rtu") {
-    return std::make_unique<modbus::ModbusDriver>(modbus_);
+  if (!ok_ || entry_ == nullptr) {
+    throw std::logic_error("driver registry: no valid driver section was read");
   }
-  return std::make_unique<SimulatedTransducer>(plant_);
+  return entry_->create(sections_);
 }
 
 }  // namespace selfsense::drivers

@@ -1,4 +1,4 @@
-#include "sim/simulated_transducer.hpp"
+#include "selfsense/drivers/sim/simulated_transducer.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "spi/ads131m04.hpp"
+#include "selfsense/drivers/spi/ads131m04.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "spi/dac8563.hpp"
+#include "selfsense/drivers/spi/dac8563.hpp"
 
 #include <cmath>
 

@@ -5,7 +5,7 @@
 #include <ctime>
 #include <utility>
 
-#include "spi/gpio_line.hpp"
+#include "selfsense/drivers/spi/gpio_line.hpp"
 
 namespace selfsense::drivers::spi {
 

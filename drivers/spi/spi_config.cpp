@@ -1,7 +1,8 @@
-#include "spi/spi_config.hpp"
+#include "selfsense/drivers/spi/spi_config.hpp"
 
 #include <cmath>
 
+#include "selfsense/base/format_number.hpp"
 #include "selfsense/operators/parameter_error.hpp"
 
 namespace selfsense::drivers::spi {
@@ -47,7 +48,7 @@ std::vector<std::string> SpiConfig::problems(double loop_rate_hz) const {
   const auto check = [&p](bool ok, const std::string& message) {
     if (!ok) p.push_back(message);
   };
-  const auto num = [](double v) { return operators::format_number(v); };
+  const auto num = [](double v) { return base::format_number(v); };
   check(!adc.device.empty(), "adc.device: must name a spidev device (/dev/spidevB.C)");
   check(adc.speed_hz >= 100000 && adc.speed_hz <= 25000000,
         "adc.speed_hz: " + std::to_string(adc.speed_hz) + " must be within [100000, 25000000]");

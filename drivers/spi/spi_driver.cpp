@@ -1,4 +1,4 @@
-#include "spi/spi_driver.hpp"
+#include "selfsense/drivers/spi/spi_driver.hpp"
 
 #include <algorithm>
 #include <cmath>

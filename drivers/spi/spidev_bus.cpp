@@ -7,7 +7,7 @@
 #include <cstring>
 #include <utility>
 
-#include "spi/spi_bus.hpp"
+#include "selfsense/drivers/spi/spi_bus.hpp"
 
 namespace selfsense::drivers::spi {
 

@@ -8,8 +8,8 @@
 #include <string>
 
 #include "commands.hpp"
-#include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 
 namespace selfsense::cli {
 

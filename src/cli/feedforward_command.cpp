@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "field_signals.hpp"
+#include "selfsense/base/format_number.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/operators/hysteresis_creep.hpp"
@@ -52,9 +53,9 @@ void run_feedforward(const FeedforwardOptions& opt) {
   const auto t = rec.column("t");
   const double ts = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
   if (std::abs(ts - model.sample_time) > 0.01 * model.sample_time) {
-    throw io::RecordingError(opt.trajectory.string() + ": sample time " +
-                             operators::format_number(ts) + " s differs from the model's " +
-                             operators::format_number(model.sample_time) + " s");
+    throw io::RecordingError(opt.trajectory.string() + ": sample time " + base::format_number(ts) +
+                             " s differs from the model's " +
+                             base::format_number(model.sample_time) + " s");
   }
   const models::SideModel& a = *model.actuator;
   operators::HysteresisCreep op(a.op, a.sample_time);

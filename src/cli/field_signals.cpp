@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 
+#include "selfsense/base/format_number.hpp"
 #include "selfsense/operators/parameter_error.hpp"
 
 namespace selfsense::cli {
@@ -65,9 +66,8 @@ FieldSignals field_signals(const io::Recording& rec, const std::string& source,
     const double dt = out.t[k] - out.t[k - 1];
     if (std::abs(dt - out.sample_time) > 0.05 * out.sample_time) {
       throw io::RecordingError(source + ": column 't': not uniformly sampled: step " +
-                               operators::format_number(dt) + " s at data row " +
-                               std::to_string(k + 1) + ", mean step " +
-                               operators::format_number(out.sample_time) + " s");
+                               base::format_number(dt) + " s at data row " + std::to_string(k + 1) +
+                               ", mean step " + base::format_number(out.sample_time) + " s");
     }
   }
   return out;

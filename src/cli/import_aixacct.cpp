@@ -9,12 +9,12 @@
 #include <vector>
 
 #include "import_text.hpp"
-#include "selfsense/operators/parameter_error.hpp"
+#include "selfsense/base/format_number.hpp"
 
 namespace selfsense::cli {
 namespace {
 
-using operators::format_number;
+using base::format_number;
 
 struct Block {
   std::size_t header{0};  // index into the lines of the "Time [s]" header

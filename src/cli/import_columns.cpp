@@ -9,12 +9,12 @@
 #include <utility>
 
 #include "import_text.hpp"
-#include "selfsense/operators/parameter_error.hpp"
+#include "selfsense/base/format_number.hpp"
 
 namespace selfsense::cli {
 namespace {
 
-using operators::format_number;
+using base::format_number;
 
 std::string where(const std::string& file, std::size_t line, const ColumnMap& m) {
   return file + ":" + std::to_string(line) + ": column " + std::to_string(m.column) + " ('" +

@@ -1,8 +1,8 @@
 // The simulated transducer as a CAN node: receives the command frame, steps the plant in real
 // time with the command held between frames (zero-order hold, like a DAC) and sends the input
 // frames (E, D and, when the layout has them, the reference S and T) every period, encoded with
-// the layout of the daemon's own configuration (drivers/can/can_codec.hpp), so both ends agree
-// by construction.
+// the layout of the daemon's own configuration (include/selfsense/drivers/can/can_codec.hpp), so
+// both ends agree by construction.
 //
 // One thread: sleep to the next period (absolute deadline on CLOCK_MONOTONIC), drain the
 // received command frames, step the plant, send. Round trip: from sending an input frame to the
@@ -30,10 +30,10 @@
 #include <span>
 #include <vector>
 
-#include "can/can_codec.hpp"
-#include "can/can_config.hpp"
-#include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
+#include "selfsense/drivers/can/can_codec.hpp"
+#include "selfsense/drivers/can/can_config.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 #include "selfsense/plant/plant.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
 #include "selfsense/runtime/latency_histogram.hpp"

@@ -1,5 +1,6 @@
 // The simulated transducer as a Modbus server (TCP or RTU) over libmodbus, with the default
-// register map of the Modbus driver (drivers/modbus/register_map.hpp, docs/drivers/modbus.md).
+// register map of the Modbus driver (include/selfsense/drivers/modbus/register_map.hpp,
+// docs/drivers/modbus.md).
 //
 // One thread: ppoll() on the bus descriptors until the next update deadline (absolute, on
 // CLOCK_MONOTONIC). Each update writes the command register's value to the simulated amplifier
@@ -27,9 +28,9 @@
 #include <string>
 #include <vector>
 
-#include "modbus/register_map.hpp"
+#include "selfsense/drivers/modbus/register_map.hpp"
+#include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
-#include "sim/simulated_transducer.hpp"
 #include "sim_device.hpp"
 
 namespace selfsense::cli {

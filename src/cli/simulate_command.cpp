@@ -15,6 +15,7 @@
 #include "field_signals.hpp"
 #include "model_runs.hpp"
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
+#include "selfsense/base/format_number.hpp"
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
@@ -74,7 +75,7 @@ void run_adapted(const models::TransducerModel& model, const FieldSignals& signa
 void report(const ModelRuns& runs, const models::StatusCounts& counts) {
   if (runs.rediscretised) {
     std::printf("model re-discretised for the recording's sample time %s s\n",
-                operators::format_number(runs.sample_time).c_str());
+                base::format_number(runs.sample_time).c_str());
   }
   std::printf("samples: %s\n", describe(counts).c_str());
 }

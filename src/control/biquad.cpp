@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "selfsense/base/format_number.hpp"
 #include "selfsense/control/parameter_error.hpp"
 
 namespace selfsense::control {
@@ -15,15 +16,15 @@ bool BiquadCoefficients::is_valid(std::string* why) const {
     return false;
   }
   if (!(std::abs(a2) < 1.0)) {
-    return check::fail("Biquad.a2", check::number(a2) + " must be inside (-1, 1) (unstable poles)",
-                       why);
+    return check::fail("Biquad.a2",
+                       base::format_number(a2) + " must be inside (-1, 1) (unstable poles)", why);
   }
   if (!(std::abs(a1) < 1.0 + a2)) {
     // Appended piece by piece: GCC 12 warns (-Wrestrict) on "literal" + std::string here.
     std::string message = "|";
-    message += check::number(a1);
+    message += base::format_number(a1);
     message += "| must be < 1 + a2 = ";
-    message += check::number(1.0 + a2);
+    message += base::format_number(1.0 + a2);
     message += " (unstable poles)";
     return check::fail("Biquad.a1", message, why);
   }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "selfsense/base/format_number.hpp"
 #include "selfsense/control/filter_design.hpp"
 #include "selfsense/control/parameter_error.hpp"
 
@@ -19,7 +20,7 @@ bool DampingController::Params::is_valid(double sample_time, std::string* why) c
   }
   if (std::isnan(output_limit) || !(output_limit > 0.0)) {
     return check::fail("DampingController.output_limit",
-                       check::number(output_limit) + " must be > 0", why);
+                       base::format_number(output_limit) + " must be > 0", why);
   }
   if (!check::non_negative("DampingController.dc_block_frequency", dc_block_frequency, why) ||
       (dc_block_frequency > 0.0 &&

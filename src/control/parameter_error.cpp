@@ -1,8 +1,8 @@
 #include "selfsense/control/parameter_error.hpp"
 
-#include <array>
-#include <charconv>
 #include <cmath>
+
+#include "selfsense/base/format_number.hpp"
 
 namespace selfsense::control {
 
@@ -15,17 +15,11 @@ namespace {
 
 bool describe(std::string_view name, double value, std::string_view constraint, std::string* why) {
   if (why != nullptr)
-    *why = std::string(name) + ": " + number(value) + ' ' + std::string(constraint);
+    *why = std::string(name) + ": " + base::format_number(value) + ' ' + std::string(constraint);
   return false;
 }
 
 }  // namespace
-
-std::string number(double value) {
-  std::array<char, 32> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return {buffer.data(), result.ptr};
-}
 
 bool finite(std::string_view name, double value, std::string* why) {
   return std::isfinite(value) || describe(name, value, "must be finite", why);
@@ -43,7 +37,8 @@ bool below(std::string_view name, double value, double limit, std::string_view l
            std::string* why) {
   if (!finite(name, value, why)) return false;
   if (value < limit) return true;
-  return describe(name, value, "must be < " + std::string(limit_text) + " = " + number(limit), why);
+  return describe(name, value,
+                  "must be < " + std::string(limit_text) + " = " + base::format_number(limit), why);
 }
 
 bool fail(std::string_view name, std::string_view message, std::string* why) {

@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "selfsense/base/format_number.hpp"
 #include "selfsense/control/parameter_error.hpp"
 
 namespace selfsense::control {
@@ -34,16 +35,17 @@ bool Pid::Params::is_valid(double sample_time, std::string* why) const {
                        why);
   }
   if (std::isnan(output_min) || std::isnan(output_max) || !(output_max > output_min)) {
-    return check::fail(
-        "Pid.output_max",
-        check::number(output_max) + " must be > Pid.output_min = " + check::number(output_min),
-        why);
+    return check::fail("Pid.output_max",
+                       base::format_number(output_max) +
+                           " must be > Pid.output_min = " + base::format_number(output_min),
+                       why);
   }
   if (tracking_time > 0.0 && tracking_time < sample_time) {
-    return check::fail("Pid.tracking_time",
-                       check::number(tracking_time) +
-                           " must be 0 (off) or >= sample_time = " + check::number(sample_time),
-                       why);
+    return check::fail(
+        "Pid.tracking_time",
+        base::format_number(tracking_time) +
+            " must be 0 (off) or >= sample_time = " + base::format_number(sample_time),
+        why);
   }
   return true;
 }

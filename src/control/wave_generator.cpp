@@ -7,6 +7,7 @@
 #include <string_view>
 #include <utility>
 
+#include "selfsense/base/format_number.hpp"
 #include "selfsense/control/parameter_error.hpp"
 
 namespace selfsense::control {
@@ -50,9 +51,9 @@ bool valid_table(const WaveGenerator::Config& c, std::string* why) {
   for (std::size_t i = 1; i < c.table_times.size(); ++i) {
     if (!(c.table_times[i] > c.table_times[i - 1])) {
       return check::fail(indexed("WaveGenerator.table_times", i),
-                         check::number(c.table_times[i]) + " must be > " +
+                         base::format_number(c.table_times[i]) + " must be > " +
                              indexed("WaveGenerator.table_times", i - 1) + " = " +
-                             check::number(c.table_times[i - 1]),
+                             base::format_number(c.table_times[i - 1]),
                          why);
     }
   }
@@ -115,7 +116,8 @@ bool WaveGenerator::Config::is_valid(double sample_time, std::string* why) const
   if (!(period / sample_time >= 2.0)) {
     return check::fail(
         period_parameter(*this),
-        "gives a period of " + check::number(period / sample_time) + " samples, must be >= 2", why);
+        "gives a period of " + base::format_number(period / sample_time) + " samples, must be >= 2",
+        why);
   }
   return true;
 }

@@ -341,6 +341,7 @@ ConfigResult load_config(const std::filesystem::path& path, DriverSectionReader*
     }
     driver.finish();
     root.finish();
+    result.known_keys.assign(root.known_keys().begin(), root.known_keys().end());
     // Filters designed for the loop (the design checks what validate() does not).
     for (std::size_t i = 0; i < c.filters.size() && i < control::FilterChain::kMaxSections; ++i) {
       const FilterSection& f = c.filters[i];

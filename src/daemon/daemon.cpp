@@ -16,6 +16,7 @@
 #include "selfsense/daemon/model_state_file.hpp"
 #include "selfsense/daemon/prometheus.hpp"
 #include "selfsense/daemon/recorder_metrics.hpp"
+#include "selfsense/daemon/reload_keys.hpp"
 #include "selfsense/daemon/telemetry_metrics.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/models/model_identity.hpp"
@@ -227,42 +228,13 @@ ReloadResult Daemon::reload() {
   }
   const DaemonConfig& n = next.config;
   std::vector<std::string>& problems = result.problems;
-  const auto refuse = [&](bool changed, const char* key) {
-    if (changed) {
-      problems.push_back(config_.source.string() + ": " + key +
-                         ": cannot change while running (restart the service)");
-    }
-  };
-  const DaemonConfig& o = config_;
-  refuse(n.loop.rate_hz != o.loop.rate_hz, "loop.rate_hz");
-  refuse(n.loop.priority != o.loop.priority, "loop.priority");
-  refuse(n.loop.cpu != o.loop.cpu, "loop.cpu");
-  refuse(n.loop.allow_degraded_timing != o.loop.allow_degraded_timing,
-         "loop.allow_degraded_timing");
-  refuse(n.loop.status_period_cycles != o.loop.status_period_cycles, "loop.status_period_cycles");
-  refuse(n.model_state != o.model_state, "model_state");
-  refuse(n.driver_type != o.driver_type, "driver.type");
-  refuse(n.driver_type == o.driver_type && n.driver_section != o.driver_section, "driver");
+  // Every key has a row in reload_keys.hpp; the live ones are applied below (the tuning), the
+  // model only while disarmed, and a changed refused one is named.
+  for (const std::string& key : refused_changes(config_, n)) {
+    problems.push_back(config_.source.string() + ": " + key +
+                       ": cannot change while running (restart the service)");
+  }
   const runtime::ControllerConfig& nc = n.control;
-  const runtime::ControllerConfig& oc = o.control;
-  const auto without_gains = [](control::Pid::Params p) {
-    p.gains = {};
-    return p;
-  };
-  refuse(nc.mode != oc.mode, "control.mode");
-  refuse(nc.feedforward != oc.feedforward, "control.feedforward");
-  refuse(nc.force_direction != oc.force_direction, "control.force_direction");
-  refuse(without_gains(nc.position) != without_gains(oc.position),
-         "control.position (only kp, ki, kd reload)");
-  refuse(without_gains(nc.force) != without_gains(oc.force),
-         "control.force (only kp, ki, kd reload)");
-  refuse(nc.position_shaper != oc.position_shaper, "control.position_shaper");
-  refuse(nc.force_shaper != oc.force_shaper, "control.force_shaper");
-  refuse(nc.damping != oc.damping, "control.damping");
-  refuse(n.safety != o.safety, "safety");
-  refuse(n.recorder != o.recorder, "recorder");
-  refuse(n.socket != o.socket, "socket");
-  refuse(n.telemetry != o.telemetry, "telemetry");
 
   // The model, read once more: load_config checked it, but the file may have changed since.
   std::unique_ptr<models::Reconstruction> reconstruction;

@@ -3,12 +3,12 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include <array>
 #include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <set>
-#include <system_error>
+
+#include "selfsense/base/errno_text.hpp"
+#include "selfsense/base/format_number.hpp"
 
 namespace selfsense::daemon {
 
@@ -44,19 +44,16 @@ void append_value(std::string& out, double value) {
     out += value > 0 ? "+Inf" : "-Inf";
     return;
   }
-  std::array<char, 32> text{};
   constexpr double kExactIntegers = 9007199254740992.0;  // 2^53
-  char* end = nullptr;
   if (value == std::trunc(value) && std::fabs(value) < kExactIntegers) {
-    end = std::to_chars(text.data(), text.data() + text.size(), static_cast<long long>(value)).ptr;
+    out += std::to_string(static_cast<long long>(value));  // "1000000", not "1e+06"
   } else {
-    end = std::to_chars(text.data(), text.data() + text.size(), value).ptr;
+    out += base::format_number(value);
   }
-  out.append(text.data(), static_cast<std::size_t>(end - text.data()));
 }
 
 [[noreturn]] void fail_errno(const std::string& what) {
-  throw std::runtime_error(what + ": " + std::generic_category().message(errno));
+  throw std::runtime_error(what + ": " + base::errno_text(errno));
 }
 
 }  // namespace

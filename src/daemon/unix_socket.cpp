@@ -5,7 +5,6 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include <array>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -96,12 +95,6 @@ int Fd::release() noexcept {
 void Fd::reset() noexcept {
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
-}
-
-std::string errno_text(int error) {
-  std::array<char, 256> buffer{};
-  // GNU strerror_r: returns the message, in buffer or static.
-  return ::strerror_r(error, buffer.data(), buffer.size());
 }
 
 sockaddr_un address_of(const std::filesystem::path& path) {

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "selfsense/base/errno_text.hpp"
 #include "selfsense/daemon/control_server.hpp"
 
 namespace selfsense::daemon::detail {
@@ -35,7 +36,7 @@ class Fd final {
 };
 
 // The text of an errno value (thread-safe).
-[[nodiscard]] std::string errno_text(int error);
+using base::errno_text;
 
 // The socket address of a path; throws std::runtime_error when the path does not fit.
 [[nodiscard]] sockaddr_un address_of(const std::filesystem::path& path);

@@ -17,9 +17,10 @@
 #include <cmath>
 #include <fstream>
 #include <string>
-#include <system_error>
 #include <utility>
 
+#include "selfsense/base/errno_text.hpp"
+#include "selfsense/base/format_number.hpp"
 #include "selfsense/io/recording.hpp"
 
 namespace selfsense::io {
@@ -73,9 +74,8 @@ constexpr std::size_t kMaxNumberChars = 24;
 // Cells quoted in messages are cut so that a runaway line cannot flood the terminal.
 constexpr std::size_t kMaxQuotedChars = 40;
 
-std::string errno_text(int error) {
-  return error == 0 ? std::string("unknown reason") : std::generic_category().message(error);
-}
+using base::errno_text;
+using base::format_number;
 
 [[noreturn]] void fail(const std::string& file, std::size_t line, std::string_view what) {
   throw RecordingError(file + ":" + std::to_string(line) + ": " + std::string(what));
@@ -93,12 +93,6 @@ std::string quote_text(std::string_view text) {
   if (text.size() > kMaxQuotedChars) quoted += "...";
   quoted += '\'';
   return quoted;
-}
-
-std::string format_number(double value) {
-  std::array<char, kMaxNumberChars + 8> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return {buffer.data(), result.ptr};
 }
 
 bool is_blank(std::string_view line) noexcept {

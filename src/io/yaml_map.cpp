@@ -144,6 +144,7 @@ bool YamlMap::has(std::string_view key) const {
 }
 
 YAML::Node YamlMap::take(std::string_view key, bool required) {
+  context_->known.insert(path(key));
   for (const auto& pair : node_) {
     if (pair.first.Scalar() != key) continue;
     consumed_.emplace(key);

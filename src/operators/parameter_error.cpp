@@ -1,18 +1,10 @@
 #include "selfsense/operators/parameter_error.hpp"
 
-#include <array>
-#include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <sstream>
 
 namespace selfsense::operators {
-
-std::string format_number(double value) {
-  std::array<char, 32> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return {buffer.data(), result.ptr};
-}
 
 void require_valid(bool valid, const std::string& why) {
   if (!valid) throw ParameterError(why);

@@ -6,9 +6,9 @@
 #include <exception>
 #include <filesystem>
 
-#include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
 #include "selfsense/daemon/daemon.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"selfsensed: real-time self-sensing piezo controller"};

@@ -1,11 +1,12 @@
-// The CAN signal codec per call (drivers/can/can_codec.hpp): what the bus thread spends per
-// decoded signal and write() per encoded command. Figures, not a test (docs/drivers/can.md).
+// The CAN signal codec per call (include/selfsense/drivers/can/can_codec.hpp): what the bus thread
+// spends per decoded signal and write() per encoded command. Figures, not a test
+// (docs/drivers/can.md).
 #include <benchmark/benchmark.h>
 
 #include <array>
 #include <cstdint>
 
-#include "can/can_codec.hpp"
+#include "selfsense/drivers/can/can_codec.hpp"
 
 namespace {
 

@@ -39,9 +39,9 @@
 #include <thread>
 #include <vector>
 
-#include "registry/registry.hpp"
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/daemon/config.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/models/runtime_model.hpp"
 #include "selfsense/runtime/loop.hpp"

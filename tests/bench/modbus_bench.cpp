@@ -30,7 +30,7 @@
 #include <thread>
 
 #include "drivers/modbus/sim_device_process.hpp"
-#include "modbus/modbus_driver.hpp"
+#include "selfsense/drivers/modbus/modbus_driver.hpp"
 
 namespace {
 

@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -17,6 +16,7 @@
 #include <vector>
 
 #include "selfsense/daemon/recorder.hpp"
+#include "support/loop_samples.hpp"
 
 namespace {
 
@@ -24,26 +24,9 @@ namespace fs = std::filesystem;
 using selfsense::daemon::Recorder;
 using selfsense::daemon::RecorderConfig;
 using selfsense::runtime::LoopSample;
+using selfsense::test::synthetic_sample;
 
-constexpr double kTs = 5e-5;  // 20 kHz
-
-LoopSample sample(std::int64_t cycle) {
-  const double t = static_cast<double>(cycle) * kTs;
-  const double phase = 2.0 * M_PI * 3.0 * t;
-  LoopSample s;
-  s.cycle = cycle;
-  s.t = t;
-  s.e = 1.0e6 * (1.0 + std::sin(phase));
-  s.d = 0.02 * (1.0 + std::sin(phase - 0.1));
-  s.t_hat = -1.0e5 * std::cos(phase);
-  s.s_hat = 5e-4 * (1.0 + std::sin(phase - 0.05));
-  s.setpoint = 5e-4 * (1.0 + std::sin(phase));
-  s.command = s.e;
-  s.s_ref = s.s_hat * 1.001;
-  s.t_ref = s.t_hat * 0.999;
-  s.state = selfsense::runtime::LoopState::kArmed;
-  return s;
-}
+constexpr double kTs = selfsense::test::kSampleTime;  // 20 kHz
 
 fs::path scratch(const std::string& name) {
   fs::path dir =
@@ -76,7 +59,7 @@ void BM_WriterRows(benchmark::State& state) {
     for (std::int64_t k = 0; k < kRows; ++k) {
       while (recorder.queued() + 1 >= recorder.capacity())
         std::this_thread::yield();
-      recorder.push(sample(k));
+      recorder.push(synthetic_sample(k));
     }
     recorder.stop_file();
     recorder.stop();
@@ -114,7 +97,7 @@ void BM_PushCost(benchmark::State& state) {
       next += std::chrono::microseconds(50);
       while (std::chrono::steady_clock::now() < next) {
       }
-      const LoopSample s = sample(cycle++);
+      const LoopSample s = synthetic_sample(cycle++);
       const auto t0 = std::chrono::steady_clock::now();
       const bool ok = recorder.push(s);
       const auto t1 = std::chrono::steady_clock::now();

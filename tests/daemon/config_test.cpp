@@ -5,37 +5,20 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <string>
 
-#include "registry/registry.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
+#include "support/config_edits.hpp"
 
 namespace selfsense::daemon {
 namespace {
 
-const std::filesystem::path kConfigDir = std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config";
+const std::filesystem::path kConfigDir = test::shipped_config_dir();
 
-// Writes a configuration beside the shipped ones (so models/ and plant/ resolve).
-std::filesystem::path write(const std::string& name, const std::string& text) {
-  std::filesystem::path path = kConfigDir / (".test-" + name + ".yaml");
-  std::ofstream(path) << text;
-  return path;
-}
-
-std::string sim_with(const std::string& from, const std::string& to) {
-  std::ifstream in(kConfigDir / "sim.yaml");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  if (at != std::string::npos) text.replace(at, from.size(), to);
-  return text;
-}
-
-ConfigResult load(const std::filesystem::path& path) {
+// config/sim.yaml with the edits, loaded as .test-NAME.yaml from a scratch directory.
+ConfigResult load_sim(const std::string& name, const test::Edits& edits) {
   drivers::Registry registry;
-  ConfigResult r = load_config(path, &registry);
-  std::filesystem::remove(path);
-  return r;
+  return test::load_shipped_with("sim.yaml", edits, registry, ".test-" + name + ".yaml");
 }
 
 bool has(const ConfigResult& r, const std::string& text) {
@@ -74,32 +57,29 @@ TEST(DaemonConfig, TheSimulatedBenchHoldsASharedMachineAndTheServiceIsStrict) {
 }
 
 TEST(DaemonConfig, UnknownKeysAreNamedWithTheirLine) {
-  const ConfigResult r =
-      load(write("unknown", sim_with("  priority: 80", "  priority: 80\n  prio: 3")));
+  const ConfigResult r = load_sim("unknown", {{"  priority: 80", "  priority: 80\n  prio: 3"}});
   ASSERT_FALSE(r.ok());
   EXPECT_TRUE(has(r, ".test-unknown.yaml:")) << r.problems.front();
   EXPECT_TRUE(has(r, "loop.prio")) << r.problems.front();
 }
 
 TEST(DaemonConfig, TheCpuLatencyRequestIsReadAndBounded) {
-  const ConfigResult shipped = load(write("latency", sim_with("rate_hz: 10000", "rate_hz: 10000")));
+  const ConfigResult shipped = load_sim("latency", {{"rate_hz: 10000", "rate_hz: 10000"}});
   ASSERT_TRUE(shipped.ok()) << shipped.problems.front();
   EXPECT_EQ(shipped.config.loop.cpu_dma_latency_us, 0);
   const ConfigResult none =
-      load(write("latency", sim_with("cpu_dma_latency_us: 0", "cpu_dma_latency_us: -1")));
+      load_sim("latency", {{"cpu_dma_latency_us: 0", "cpu_dma_latency_us: -1"}});
   ASSERT_TRUE(none.ok()) << none.problems.front();
   EXPECT_EQ(none.config.loop.cpu_dma_latency_us, -1);
   const ConfigResult bad =
-      load(write("latency", sim_with("cpu_dma_latency_us: 0", "cpu_dma_latency_us: -5")));
+      load_sim("latency", {{"cpu_dma_latency_us: 0", "cpu_dma_latency_us: -5"}});
   EXPECT_TRUE(has(bad, ".test-latency.yaml:9: loop.cpu_dma_latency_us: -5 must be -1"))
       << (bad.problems.empty() ? "" : bad.problems.front());
 }
 
 TEST(DaemonConfig, EveryValueProblemIsReportedAtOnce) {
-  std::string text = sim_with("rate_hz: 10000", "rate_hz: 3000");  // notch 2 kHz > 0.45 fs
-  const std::size_t at = text.find("priority: 80");
-  text.replace(at, 12, "priority: 120");
-  const ConfigResult r = load(write("values", text));
+  const ConfigResult r = load_sim("values", {{"rate_hz: 10000", "rate_hz: 3000"},  // notch 2 kHz
+                                             {"priority: 80", "priority: 120"}});
   EXPECT_TRUE(has(r, "loop.priority: 120 must be within [1, 99]"));
   EXPECT_TRUE(
       has(r, "control.filters[0].frequency_hz: 2000 Hz must be below 0.45 of the loop rate"));
@@ -112,23 +92,25 @@ TEST(DaemonConfig, EveryValueProblemIsReportedAtOnce) {
 }
 
 TEST(DaemonConfig, CrossFieldRules) {
-  const ConfigResult r = load(write("cross", sim_with("  setpoint_strain: [-5.0e-4, 1.5e-3]",
-                                                      "  setpoint_strain: [-5.0e-4, 3.0e-3]")));
+  const ConfigResult r = load_sim(
+      "cross", {{"  setpoint_strain: [-5.0e-4, 1.5e-3]", "  setpoint_strain: [-5.0e-4, 3.0e-3]"}});
   EXPECT_TRUE(has(r, "safety.setpoint_strain: must be an interval inside safety.strain_range"));
   const ConfigResult safe =
-      load(write("safe", sim_with("safe_value_v_per_m: 0.0", "safe_value_v_per_m: 3.0e6")));
+      load_sim("safe", {{"safe_value_v_per_m: 0.0", "safe_value_v_per_m: 3.0e6"}});
   EXPECT_TRUE(has(safe, "safety.safe_value_v_per_m: must be inside control.command_v_per_m"));
 }
 
 TEST(DaemonConfig, ModelAndDriverProblemsAreNamed) {
   const ConfigResult missing =
-      load(write("model", sim_with("model: models/sim.yaml", "model: models/none.yaml")));
+      load_sim("model", {{"model: models/sim.yaml", "model: models/none.yaml"}});
   EXPECT_TRUE(has(missing, "model: ")) << missing.problems.front();
-  const ConfigResult driver = load(write("driver", sim_with("type: simulated", "type: ethercat")));
-  EXPECT_TRUE(has(driver, "driver.type: 'ethercat' is not one of simulated"));
-  const ConfigResult mode = load(write("mode", sim_with("mode: position", "mode: speed")));
+  const ConfigResult driver = load_sim("driver", {{"type: simulated", "type: ethercat"}});
+  EXPECT_TRUE(has(
+      driver, "driver.type: 'ethercat' is not one of simulated, can, modbus-tcp, modbus-rtu, spi"))
+      << driver.problems.front();
+  const ConfigResult mode = load_sim("mode", {{"mode: position", "mode: speed"}});
   EXPECT_TRUE(has(mode, "control.mode: 'speed' is not one of position, force, open-loop, damping"));
-  const ConfigResult version = load(write("version", sim_with("selfsensed: 1", "selfsensed: 2")));
+  const ConfigResult version = load_sim("version", {{"selfsensed: 1", "selfsensed: 2"}});
   EXPECT_TRUE(has(version, "selfsensed: format version 2 is not supported"));
 }
 

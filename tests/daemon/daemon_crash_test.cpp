@@ -11,8 +11,8 @@
 #include <random>
 #include <string>
 
-#include "daemon/daemon_process.hpp"
 #include "daemon/recording_support.hpp"
+#include "daemon/running_daemon.hpp"
 #include "selfsense/io/recording.hpp"
 
 namespace selfsense::daemon {

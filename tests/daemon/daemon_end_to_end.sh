@@ -62,19 +62,21 @@ grep -q '"state"' "$out/status.json" || fail "status has no state"
 grep -q '"recording"' "$out/status.json" || fail "status has no recording"
 [ -s "$out/main_job.html" ] && grep -q '<svg' "$out/main_job.html" || fail "no plots in the page"
 
-# A bad configuration: non-zero exit, every problem named with file and line.
-bad=$root/config/.e2e-bad.yaml
+# A bad configuration: non-zero exit, every problem named with file and line. The changed copies
+# are written into the scratch directory beside links to config/models and config/plant.
+# shellcheck source=tests/support/scratch_config.sh
+source "$root/tests/support/scratch_config.sh"
+link_shipped_config_dirs "$root" "$out"
+bad=$out/.e2e-bad.yaml
 sed -e 's/rate_hz: 10000/rate_hz: 3000/' -e 's/priority: 80/priority: 200/' "$root/config/sim.yaml" >"$bad"
 if "$build/src/selfsensed/selfsensed" --config "$bad" 2>"$out/bad.err"; then
-  rm -f "$bad"
   fail "selfsensed started with a bad configuration"
 fi
-rm -f "$bad"
 grep -q '.e2e-bad.yaml:[0-9]*: loop.priority: 200 must be within' "$out/bad.err" || fail "priority not named: $(cat "$out/bad.err")"
 grep -q 'control.filters\[0\].frequency_hz' "$out/bad.err" || fail "notch not named: $(cat "$out/bad.err")"
 # Reload: the gains through `ctl reload` and SIGHUP; a key that cannot change while running is
 # refused by name and the daemon keeps running; SIGTERM still ends it with status 0.
-cfg=$root/config/.e2e-reload.yaml
+cfg=$out/.e2e-reload.yaml
 sed -e "s|path: ../build/sim/control.sock|path: $out/reload.sock|" \
   -e "s|directory: ../build/sim/recordings|directory: $out/reload-rec|" \
   -e "s|prometheus_file: ../build/sim/selfsensed.prom|prometheus_file: $out/reload.prom|" \
@@ -95,7 +97,6 @@ ctl status | grep -q '"state"' || fail "the daemon stopped answering after the r
 kill -TERM "$pid"
 rc=0
 wait "$pid" || rc=$?
-rm -f "$cfg"
 [ "$rc" -eq 0 ] || fail "selfsensed exited with $rc after SIGTERM"
 echo "ok: reload of the gains, refusal naming loop.rate_hz, SIGTERM exit 0"
 echo "daemon end to end: ok"

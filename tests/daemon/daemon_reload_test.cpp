@@ -7,8 +7,8 @@
 #include <cmath>
 #include <string>
 
-#include "daemon/daemon_process.hpp"
 #include "daemon/recording_support.hpp"
+#include "daemon/running_daemon.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 
 namespace selfsense::daemon {

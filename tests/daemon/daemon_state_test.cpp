@@ -10,8 +10,8 @@
 #include <string>
 #include <thread>
 
-#include "daemon/daemon_process.hpp"
 #include "daemon/recording_support.hpp"
+#include "daemon/running_daemon.hpp"
 #include "selfsense/daemon/model_state_file.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 

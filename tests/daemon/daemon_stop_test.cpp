@@ -8,8 +8,8 @@
 #include <string>
 #include <thread>
 
-#include "daemon/daemon_process.hpp"
 #include "daemon/recording_support.hpp"
+#include "daemon/running_daemon.hpp"
 #include "selfsense/io/recording.hpp"
 
 namespace selfsense::daemon {

@@ -11,8 +11,8 @@
 namespace selfsense::daemon {
 namespace {
 
-using testing::make_sample;
 using testing::ScratchDir;
+using testing::synthetic_sample;
 
 FlightRecorderConfig flight_config() {
   FlightRecorderConfig config;
@@ -31,7 +31,7 @@ TEST(FlightRecorder, DumpHoldsTheLastSecondsInOrderAndNeverOverwrites) {
   FlightRecorder flight(flight_config(), dir.path(), testing::kTs, true);
   EXPECT_EQ(flight.capacity(), 200U);
   for (int k = 0; k < 500; ++k)
-    flight.add(make_sample(k));
+    flight.add(synthetic_sample(k));
   const auto path = dir.path() / "manual.csv";
   const FlightRecorder::Dump dump = flight.dump("operator asked\nfor it", path);
   ASSERT_TRUE(dump.error.empty()) << dump.error;
@@ -40,7 +40,7 @@ TEST(FlightRecorder, DumpHoldsTheLastSecondsInOrderAndNeverOverwrites) {
   ASSERT_EQ(r.rows(), 200U);
   for (std::size_t i = 0; i < r.rows(); ++i)
     ASSERT_EQ(r.column("cycle")[i], 300.0 + static_cast<double>(i));
-  EXPECT_EQ(r.column("S")[5], make_sample(305).s_ref);
+  EXPECT_EQ(r.column("S")[5], synthetic_sample(305).s_ref);
   EXPECT_EQ(r.comments[1], "reason: operator asked for it");
   EXPECT_EQ(flight.dumps(), 1U);
 
@@ -54,16 +54,16 @@ TEST(FlightRecorder, NewFaultBitTriggersADumpAfterThePostTriggerTime) {
   FlightRecorder flight(flight_config(), dir.path(), testing::kTs, false, name_of);
   runtime::LoopSample s;
   for (int k = 0; k < 100; ++k)
-    flight.add(make_sample(k));
+    flight.add(synthetic_sample(k));
   EXPECT_FALSE(flight.auto_dump_pending());
   for (int k = 100; k < 120; ++k) {
-    s = make_sample(k);
+    s = synthetic_sample(k);
     s.faults = k >= 105 ? 0x6U : 0x4U;  // bit 2 at cycle 100, bit 1 joins at 105
     flight.add(s);
     EXPECT_TRUE(flight.auto_dump_pending());
     EXPECT_FALSE(flight.auto_dump_due()) << k;
   }
-  s = make_sample(120);
+  s = synthetic_sample(120);
   s.faults = 0x6U;
   flight.add(s);
   ASSERT_TRUE(flight.auto_dump_due());
@@ -90,7 +90,7 @@ TEST(FlightRecorder, RecorderDumpsOnAFaultEvenWhenStoppedBeforeThePostTriggerTim
   Recorder recorder(config, name_of);
   recorder.start();
   for (int k = 0; k < 50; ++k) {
-    runtime::LoopSample s = make_sample(k);
+    runtime::LoopSample s = synthetic_sample(k);
     s.faults = k >= 40 ? 0x4U : 0U;
     ASSERT_TRUE(recorder.push(s));
   }

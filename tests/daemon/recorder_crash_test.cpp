@@ -18,8 +18,8 @@
 namespace selfsense::daemon {
 namespace {
 
-using testing::make_sample;
 using testing::ScratchDir;
+using testing::synthetic_sample;
 
 // Shared with the child: what it has seen flushed, and that it is recording.
 struct Progress {
@@ -44,7 +44,7 @@ struct Progress {
     for (std::int64_t k = 0;; ++k) {
       while (recorder.queued() + 1 >= recorder.capacity())
         std::this_thread::yield();
-      recorder.push(make_sample(k));
+      recorder.push(synthetic_sample(k));
       if (k % 256 == 0) progress.rows_flushed.store(recorder.counters().rows_flushed);
     }
   } catch (...) {

@@ -13,9 +13,9 @@
 namespace selfsense::daemon {
 namespace {
 
-using testing::make_sample;
 using testing::read_back;
 using testing::ScratchDir;
+using testing::synthetic_sample;
 
 RecorderConfig config_in(const std::filesystem::path& dir) {
   RecorderConfig config;
@@ -35,7 +35,7 @@ void push_paced(Recorder& recorder, std::int64_t from, std::int64_t to) {
   for (std::int64_t k = from; k < to; ++k) {
     while (recorder.queued() + 1 >= recorder.capacity())
       std::this_thread::sleep_for(std::chrono::microseconds(100));
-    ASSERT_TRUE(recorder.push(make_sample(k)));
+    ASSERT_TRUE(recorder.push(synthetic_sample(k)));
   }
 }
 
@@ -43,7 +43,7 @@ void expect_continuous(const testing::ReadBack& back, std::int64_t rows) {
   ASSERT_EQ(back.cycle.size(), static_cast<std::size_t>(rows));
   for (std::size_t i = 0; i < back.cycle.size(); ++i) {
     ASSERT_EQ(back.cycle[i], static_cast<double>(i)) << "row " << i;
-    ASSERT_EQ(back.t[i], make_sample(static_cast<std::int64_t>(i)).t) << "row " << i;
+    ASSERT_EQ(back.t[i], synthetic_sample(static_cast<std::int64_t>(i)).t) << "row " << i;
   }
 }
 
@@ -100,7 +100,7 @@ TEST(Recorder, AFullRingRefusesAndCountsEveryDrop) {
   Recorder recorder(config);
   int accepted = 0;
   for (int k = 0; k < 3000; ++k)
-    accepted += recorder.push(make_sample(k)) ? 1 : 0;
+    accepted += recorder.push(synthetic_sample(k)) ? 1 : 0;
   EXPECT_EQ(accepted, 1024);
   RecorderCounters c = recorder.counters();
   EXPECT_EQ(c.samples_pushed, 1024U);
@@ -140,15 +140,15 @@ TEST(Recorder, BadTimesAreCountedAndNonFiniteValuesFlagged) {
   Recorder recorder(config_in(dir.path()));
   recorder.start();
   recorder.start_file();
-  runtime::LoopSample s = make_sample(0);
+  runtime::LoopSample s = synthetic_sample(0);
   s.t_hat = runtime::LoopSample::kNone;
   recorder.push(s);
-  recorder.push(make_sample(1));
-  runtime::LoopSample bad = make_sample(2);
+  recorder.push(synthetic_sample(1));
+  runtime::LoopSample bad = synthetic_sample(2);
   bad.t = std::nan("");
-  recorder.push(bad);             // not written: counted
-  recorder.push(make_sample(1));  // t repeats: a new file
-  recorder.push(make_sample(2));
+  recorder.push(bad);                  // not written: counted
+  recorder.push(synthetic_sample(1));  // t repeats: a new file
+  recorder.push(synthetic_sample(2));
   recorder.stop();
   const RecorderCounters c = recorder.counters();
   EXPECT_EQ(c.rows_written, 4U);

@@ -12,8 +12,8 @@
 namespace selfsense::daemon {
 namespace {
 
-using testing::make_sample;
 using testing::ScratchDir;
+using testing::synthetic_sample;
 
 std::string slurp(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -25,7 +25,7 @@ TEST(RecordingFile, AppearsOnlyOnceItHoldsARow) {
   const auto path = dir.path() / "a.csv";
   RecordingFile file(RowFormat(true), 4096);
   file.open(path, {"c"});
-  file.add(make_sample(0));
+  file.add(synthetic_sample(0));
   EXPECT_FALSE(std::filesystem::exists(path));
   const RecordingFile::Result r = file.write_out();
   EXPECT_EQ(r.error, 0);
@@ -50,7 +50,7 @@ TEST(RecordingFile, EveryPageBoundaryIsARowBoundaryAndTheFileReadsBack) {
   std::mt19937 rng(7);
   constexpr int kRows = 20000;
   for (int i = 0; i < kRows; ++i) {
-    file.add(make_sample(i));
+    file.add(synthetic_sample(i));
     if (file.write_due() || rng() % 13 == 0) {
       ASSERT_EQ(file.write_out().error, 0);
     }
@@ -65,7 +65,7 @@ TEST(RecordingFile, EveryPageBoundaryIsARowBoundaryAndTheFileReadsBack) {
   ASSERT_EQ(r.rows(), static_cast<std::size_t>(kRows));
   for (int i = 0; i < kRows; ++i)
     ASSERT_EQ(r.column("cycle")[static_cast<std::size_t>(i)], i);
-  EXPECT_EQ(r.column("E")[123], make_sample(123).e);  // full precision
+  EXPECT_EQ(r.column("E")[123], synthetic_sample(123).e);  // full precision
 }
 
 TEST(RecordingFile, NamedPathThatExistsIsAnErrorAndTheRowsAreCountedLost) {
@@ -74,8 +74,8 @@ TEST(RecordingFile, NamedPathThatExistsIsAnErrorAndTheRowsAreCountedLost) {
   std::ofstream(path) << "x\n";
   RecordingFile file(RowFormat(false), 4096);
   file.open(path, {});
-  file.add(make_sample(0));
-  file.add(make_sample(1));
+  file.add(synthetic_sample(0));
+  file.add(synthetic_sample(1));
   const RecordingFile::Result r = file.write_out();
   EXPECT_NE(r.error, 0);
   EXPECT_EQ(r.rows_lost, 2U);

@@ -1,7 +1,7 @@
 // The CAN signal codec against hand-worked bytes (Intel and Motorola layouts as a DBC file gives
 // them), against an independent reference (the 8 data bytes as one 64-bit word), and at its
 // limits (sign, saturation, 64-bit signals, neighbouring bits left alone).
-#include "can/can_codec.hpp"
+#include "selfsense/drivers/can/can_codec.hpp"
 
 #include <gtest/gtest.h>
 

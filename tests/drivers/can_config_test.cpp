@@ -5,15 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "can/can_driver.hpp"
-#include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
+#include "selfsense/drivers/can/can_driver.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
+#include "support/config_edits.hpp"
 
 namespace {
 
@@ -22,31 +21,11 @@ using selfsense::daemon::load_config;
 using selfsense::drivers::Registry;
 namespace can = selfsense::drivers::can;
 
-const std::filesystem::path kConfigDir = std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config";
+const std::filesystem::path kConfigDir = selfsense::test::shipped_config_dir();
 
-std::string shipped() {
-  std::ifstream in(kConfigDir / "can-sim.yaml");
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-// can-sim.yaml with each (from, to) replaced once, loaded from beside the shipped one.
-ConfigResult load_with(const std::vector<std::pair<std::string, std::string>>& edits,
-                       Registry& registry) {
-  std::string text = shipped();
-  for (const auto& [from, to] : edits) {
-    const std::size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-  }
-  // One file per test: CTest runs the tests of this program in parallel.
-  std::string file = ".";
-  file += ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  file += ".test-can.yaml";
-  const std::filesystem::path path = kConfigDir / file;
-  std::ofstream(path) << text;
-  ConfigResult r = load_config(path, &registry);
-  std::filesystem::remove(path);
-  return r;
+// can-sim.yaml with each (from, to) replaced once, loaded from a scratch directory.
+ConfigResult load_with(const selfsense::test::Edits& edits, Registry& registry) {
+  return selfsense::test::load_shipped_with("can-sim.yaml", edits, registry, ".test-can.yaml");
 }
 
 // The problems joined, for messages and searching.

@@ -11,9 +11,9 @@
 #include <memory>
 #include <string>
 
-#include "can/can_driver.hpp"
-#include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
+#include "selfsense/drivers/can/can_driver.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace {

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <string>
 
+#include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/plant/config.hpp"
 #include "selfsense/plant/status.hpp"
-#include "sim/simulated_transducer.hpp"
 
 namespace selfsense::drivers {
 namespace {

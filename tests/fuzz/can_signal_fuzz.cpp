@@ -1,6 +1,6 @@
-// Fuzz target: CAN signal decoding (drivers/can/can_codec.hpp) of any frame data under any
-// signal layout (start bit, length, byte order, signedness, scale, offset; classic or FD).
-// Input: the layout (scale and offset from a table, or raw doubles when the first byte's top
+// Fuzz target: CAN signal decoding (include/selfsense/drivers/can/can_codec.hpp) of any frame data
+// under any signal layout (start bit, length, byte order, signedness, scale, offset; classic or
+// FD). Input: the layout (scale and offset from a table, or raw doubles when the first byte's top
 // bit is set), then the frame's data bytes.
 // Properties, for every layout is_valid() accepts:
 //  - the signal's bits are `length` distinct bits inside bytes_needed() <= the frame's bytes;
@@ -18,8 +18,8 @@
 #include <cstdint>
 #include <string>
 
-#include "can/can_codec.hpp"
 #include "fuzz_check.hpp"
+#include "selfsense/drivers/can/can_codec.hpp"
 
 namespace {
 

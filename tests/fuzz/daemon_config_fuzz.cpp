@@ -16,8 +16,8 @@
 #include <string>
 
 #include "fuzz_check.hpp"
-#include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 
 namespace {
 

@@ -1,8 +1,8 @@
-// Fuzz target: decoding Modbus register values (drivers/modbus/register_map.hpp), the words a
-// device answers with, under register specs of every type and word order.
-// Input: type, word order, scale, offset and range (from tables of realistic register scalings,
-// or raw doubles when the first byte's top bit is set), a test value, then the words.
-// Properties, for every spec that problem() accepts:
+// Fuzz target: decoding Modbus register values (include/selfsense/drivers/modbus/register_map.hpp),
+// the words a device answers with, under register specs of every type and word order. Input: type,
+// word order, scale, offset and range (from tables of realistic register scalings, or raw doubles
+// when the first byte's top bit is set), a test value, then the words. Properties, for every spec
+// that problem() accepts:
 //  - decode() of any words: kOk means a finite value inside [min, max], kOutOfRange a finite
 //    value outside it, kNotFinite a NaN or infinity;
 //  - with a table scaling, a value decoded kOk encodes back (encode() true) to words that decode
@@ -18,7 +18,7 @@
 #include <string>
 
 #include "fuzz_check.hpp"
-#include "modbus/register_map.hpp"
+#include "selfsense/drivers/modbus/register_map.hpp"
 
 namespace {
 

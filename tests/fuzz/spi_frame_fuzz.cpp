@@ -1,6 +1,6 @@
-// Fuzz target: the ADS131M04's output frames (drivers/spi/ads131m04.hpp), the bytes the ADC
-// clocks out on DOUT, through the frame codec and through the SPI driver's read path
-// (drivers/spi/spi_driver.hpp).
+// Fuzz target: the ADS131M04's output frames (include/selfsense/drivers/spi/ads131m04.hpp), the
+// bytes the ADC clocks out on DOUT, through the frame codec and through the SPI driver's read path
+// (include/selfsense/drivers/spi/spi_driver.hpp).
 // Input: one set-up byte, then frames of kFrameBytes (18) bytes, each the ADC's reply to one
 // transfer; a last partial frame is ignored. The set-up byte: bits 0-1 the front end (the
 // emulated bench's; other channels, PGA gain 2; offsets; narrow ranges), bits 2-3 stuck_frames
@@ -44,12 +44,12 @@
 #include <string_view>
 
 #include "fuzz_check.hpp"
+#include "selfsense/drivers/spi/ads131m04.hpp"
+#include "selfsense/drivers/spi/spi_bus.hpp"
+#include "selfsense/drivers/spi/spi_config.hpp"
+#include "selfsense/drivers/spi/spi_driver.hpp"
 #include "selfsense/runtime/driver.hpp"
 #include "selfsense/runtime/pacer.hpp"
-#include "spi/ads131m04.hpp"
-#include "spi/spi_bus.hpp"
-#include "spi/spi_config.hpp"
-#include "spi/spi_driver.hpp"
 #include "support/spi/ads131m04_emulator.hpp"
 #include "support/spi/dac8563_emulator.hpp"
 #include "support/spi/emulated_line.hpp"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The build's layering, as a check that fails (architecture.md): every header and source of a
-# library may include project headers only from the libraries it is allowed to depend on, and the
-# pure-math libraries include nothing that does files, threads, sockets or formats.
+# library, a driver (drivers/) and the programs (src/cli, src/selfsensed) may include project
+# headers only from the libraries it is allowed to depend on, and the pure-math libraries include
+# nothing that does files, threads, sockets or formats.
 #
 #   check_layering.sh SOURCE_DIR
 # Prints one line per violation (FILE:LINE: what) and exits 1 if there is any.
@@ -9,24 +10,41 @@ set -euo pipefail
 root=${1:?usage: check_layering.sh SOURCE_DIR}
 cd "$root"
 
-# library folder -> the include folders it may use (itself first). A folder missing here is
-# not checked (the tools and tests may use everything).
+# library folder -> the include folders it may use (itself first). A library's headers are in
+# include/selfsense/LIB and its sources in src/LIB; a driver's in include/selfsense/drivers/NAME
+# and drivers/NAME (key drivers/NAME); the programs (cli, selfsensed) have sources only. "*": every
+# library known here. The tests may use everything.
 declare -A allowed=(
-  [operators]="operators"
-  [models]="models operators"
-  [adaptation]="adaptation models operators"
-  [control]="control"
-  [plant]="plant"
-  [identification]="identification models operators"
-  [diagnosis]="diagnosis identification models operators"
-  [io]="io"
-  [model_io]="model_io models operators io"
-  [plant_io]="plant_io plant io"
-  [runtime]="runtime models operators control"
-  [daemon]="daemon runtime models operators control io model_io"
+  [base]="base"
+  [operators]="operators base"
+  [models]="models operators base"
+  [adaptation]="adaptation models operators base"
+  [control]="control base"
+  [plant]="plant base"
+  [identification]="identification models operators base"
+  [diagnosis]="diagnosis identification models operators base"
+  [io]="io base"
+  [model_io]="model_io models operators io base"
+  [plant_io]="plant_io plant io base"
+  [runtime]="runtime models operators control base"
+  [daemon]="daemon runtime models operators control io model_io base"
+  [drivers/sim]="drivers/sim runtime models operators control plant base"
+  [drivers/can]="drivers/can runtime models operators control io base"
+  [drivers/modbus]="drivers/modbus runtime models operators control io base"
+  [drivers/spi]="drivers/spi runtime models operators control io base"
+  [drivers/registry]="drivers/registry drivers/sim drivers/can drivers/modbus drivers/spi daemon runtime models operators control io model_io plant plant_io base"
+  [cli]="*"
+  [selfsensed]="selfsensed daemon drivers/registry runtime models operators control io model_io base"
 )
-# The math: no files, streams, threads, clocks, sockets or file formats.
-math="operators models adaptation control plant identification diagnosis"
+folders_of() {
+  case "$1" in
+    drivers/*) echo "include/selfsense/$1 $1" ;;
+    cli | selfsensed) echo "src/$1" ;;
+    *) echo "include/selfsense/$1 src/$1" ;;
+  esac
+}
+# The math and its ground floor: no files, streams, threads, clocks, sockets or file formats.
+math="base operators models adaptation control plant identification diagnosis"
 forbidden_system='fstream|iostream|filesystem|thread|mutex|condition_variable|future|chrono|cstdio|yaml-cpp/.*|nlohmann/.*|sys/.*|unistd\.h|fcntl\.h|pthread\.h'
 
 violations=0
@@ -36,17 +54,22 @@ report() {
 }
 
 for lib in "${!allowed[@]}"; do
-  for dir in "include/selfsense/$lib" "src/$lib"; do
+  for dir in $(folders_of "$lib"); do
     [ -d "$dir" ] || continue
     while IFS= read -r hit; do
       file=${hit%%:*}
       rest=${hit#*:}
       line=${rest%%:*}
-      target=$(sed -E 's/.*#include "selfsense\/([a-z_]+)\/.*/\1/' <<<"$rest")
+      # selfsense/drivers/NAME/... -> drivers/NAME; selfsense/LIB/... -> LIB
+      target=$(sed -E 's/.*#include "selfsense\/((drivers\/)?[a-z_]+)\/.*/\1/' <<<"$rest")
       ok=0
-      for a in ${allowed[$lib]}; do
-        [ "$a" = "$target" ] && ok=1
-      done
+      if [ "${allowed[$lib]}" = "*" ]; then
+        [ -n "${allowed[$target]+x}" ] && ok=1
+      else
+        for a in ${allowed[$lib]}; do
+          [ "$a" = "$target" ] && ok=1
+        done
+      fi
       [ $ok -eq 1 ] || report "$file:$line: $lib must not include selfsense/$target (allowed: ${allowed[$lib]})"
     done < <(grep -rnE '^#include "selfsense/[a-z_]+/' "$dir" || true)
     if [[ " $math " == *" $lib "* ]]; then
@@ -58,10 +81,13 @@ for lib in "${!allowed[@]}"; do
 done
 
 # Every library folder must be known here, so a new one cannot slip past the check.
-for dir in src/*/; do
-  lib=$(basename "$dir")
-  case "$lib" in cli | selfsensed) continue ;; esac
-  [ -n "${allowed[$lib]+x}" ] || report "src/$lib: library folder not in tests/layering/check_layering.sh"
+for dir in src/*/ drivers/*/ include/selfsense/*/ include/selfsense/drivers/*/; do
+  [ -d "$dir" ] || continue
+  lib=${dir%/}
+  lib=${lib#src/}
+  lib=${lib#include/selfsense/}
+  [ "$lib" = drivers ] && continue
+  [ -n "${allowed[$lib]+x}" ] || report "${dir%/}: library folder not in tests/layering/check_layering.sh"
 done
 
 if [ "$violations" -gt 0 ]; then

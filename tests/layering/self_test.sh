@@ -26,6 +26,23 @@ printf '#pragma once\n#include <fstream>\n' >"$tmp/include/selfsense/operators/i
 expect_failure "math including <fstream>" "include/selfsense/operators/io.hpp:2: pure math (operators) must not include <fstream>"
 rm "$tmp/include/selfsense/operators/io.hpp"
 
+mkdir -p "$tmp/drivers/can" "$tmp/src/daemon"
+echo '#include "selfsense/drivers/spi/spi_bus.hpp"' >"$tmp/drivers/can/can_driver.cpp"
+expect_failure "a driver including another driver" "drivers/can/can_driver.cpp:1: drivers/can must not include selfsense/drivers/spi"
+rm "$tmp/drivers/can/can_driver.cpp"
+
+echo '#include "selfsense/drivers/can/can_driver.hpp"' >"$tmp/src/daemon/daemon.cpp"
+expect_failure "the daemon including a driver" "src/daemon/daemon.cpp:1: daemon must not include selfsense/drivers/can"
+rm "$tmp/src/daemon/daemon.cpp"
+
+echo '#include "selfsense/report/svg.hpp"' >"$tmp/src/cli/plot.cpp"
+expect_failure "the tool including an unknown library" "src/cli/plot.cpp:1: cli must not include selfsense/report"
+rm "$tmp/src/cli/plot.cpp"
+
+mkdir -p "$tmp/drivers/ethercat"
+expect_failure "an unknown driver folder" "drivers/ethercat: library folder not in"
+rmdir "$tmp/drivers/ethercat"
+
 mkdir -p "$tmp/src/newlib"
 expect_failure "an unknown library folder" "src/newlib: library folder not in"
 echo "layering self-test: ok"

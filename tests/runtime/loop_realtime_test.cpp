@@ -8,9 +8,9 @@
 
 #include "selfsense/control/filter_design.hpp"
 #include "selfsense/control/wave_generator.hpp"
+#include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/runtime/loop.hpp"
-#include "sim/simulated_transducer.hpp"
 #include "support/allocation_counter.hpp"
 #include "support/transducer_data.hpp"
 

@@ -15,10 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
-#include "sim/simulated_transducer.hpp"
 #include "support/daemon_plant.hpp"
+#include "support/shipped_model.hpp"
 
 namespace selfsense::runtime {
 namespace {
@@ -26,14 +27,7 @@ namespace {
 constexpr double kRate = 10000.0;
 constexpr double kTs = 1.0 / kRate;
 
-// The daemon's shipped model (config/models/sim.yaml: `preisach-creep` identified on the bench's
-// identification recording, config/plant/daemon.yaml, the plant of test::daemon_plant), so the
-// figures are the product's.
-const models::TransducerModel& bench_model() {
-  static const models::TransducerModel m =
-      models::load_model(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config/models/sim.yaml");
-  return m;
-}
+using test::bench_model;
 
 ControllerConfig bench_control() {
   ControllerConfig c;

@@ -4,8 +4,9 @@
 // a bad set with a ParameterError whose message names the parameter and the violated
 // constraint: "Pid.output_max: -1 must be > Pid.output_min = 0". Each Params/Config struct also
 // has a non-throwing `bool is_valid(..., std::string* why) const` for configuration loaders that
-// collect every problem. The library depends on the standard library only, so it keeps its own
-// small copy of the checks instead of linking selfsense::operators.
+// collect every problem. The library depends on the standard library and the ground floor
+// (selfsense::base) only, so it keeps its own small copy of the checks instead of linking
+// selfsense::operators.
 #pragma once
 
 #include <stdexcept>
@@ -23,9 +24,6 @@ class ParameterError final : public std::invalid_argument {
 void require_valid(bool valid, const std::string& why);
 
 namespace check {
-
-// Shortest text that reads back as the same double ("0.2", not "0.20000000000000001").
-[[nodiscard]] std::string number(double value);
 
 // Each returns false and writes "<name>: <value> must ..." to *why (if non-null) on failure.
 bool finite(std::string_view name, double value, std::string* why);

@@ -136,6 +136,10 @@ struct DaemonConfig {
 struct ConfigResult {
   DaemonConfig config{};
   std::vector<std::string> problems{};  // "FILE:LINE: KEY.PATH: what is wrong"
+  // Every key path the loader and the driver registry asked for, present in the file or not
+  // (io::YamlMap::known_keys); each has a reload class (reload_keys.hpp). Filled when the file
+  // was read to its end.
+  std::vector<std::string> known_keys{};
   [[nodiscard]] bool ok() const noexcept { return problems.empty(); }
 };
 

@@ -102,6 +102,11 @@ class YamlMap final {
   // names, else line 1. The result is one line, like every error.
   [[nodiscard]] std::string locate(const std::string& message) const;
   [[nodiscard]] const std::string& source() const noexcept { return context_->source; }
+  // Every key path a reader of this document asked for, whether the file has it or not: the
+  // keys the strict reading knows ("loop.rate_hz", "control.filters[0].type", ...).
+  [[nodiscard]] const std::set<std::string, std::less<>>& known_keys() const noexcept {
+    return context_->known;
+  }
   // The mapping's last key in the document's order (empty for an empty mapping).
   [[nodiscard]] std::string last_key() const;
   // The mapping as YAML text, comments and layout dropped: two readings compare equal when
@@ -112,6 +117,7 @@ class YamlMap final {
   struct Context {
     std::string source{};
     std::map<std::string, int, std::less<>> lines{};  // key path -> 1-based line
+    std::set<std::string, std::less<>> known{};       // every key path asked for
   };
   YamlMap(const YAML::Node& node, std::string path, std::shared_ptr<Context> context);
   YAML::Node take(std::string_view key, bool required);

@@ -12,6 +12,8 @@
 #include <string>
 #include <string_view>
 
+#include "selfsense/base/format_number.hpp"
+
 namespace selfsense::operators {
 
 class ParameterError final : public std::invalid_argument {
@@ -20,7 +22,7 @@ class ParameterError final : public std::invalid_argument {
 };
 
 // Shortest text that reads back as the same double ("0.2", not "0.20000000000000001").
-[[nodiscard]] std::string format_number(double value);
+using base::format_number;
 
 // Throws ParameterError(why) when `valid` is false. Keeps constructors to one line.
 void require_valid(bool valid, const std::string& why);

@@ -4,7 +4,7 @@
 // Faults: the server killed and restarted, frozen (SIGSTOP: requests unanswered), an unmapped
 // register (exception response), random bytes for answers. Every fault must be counted and no
 // fault may reach the loop as kOk with a number.
-#include "modbus/modbus_driver.hpp"
+#include "selfsense/drivers/modbus/modbus_driver.hpp"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -31,8 +31,8 @@
 #include <vector>
 
 #include "drivers/modbus/sim_device_process.hpp"
-#include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
 #include "support/allocation_counter.hpp"
 
 namespace selfsense::drivers::modbus {

@@ -16,12 +16,17 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../../.." && pwd)
 cli=$build/src/cli/selfsense
 export SELFSENSE_CLI=$cli  # scripts/main_job_report.sh writes the page with it
 out=$(mktemp -d)
-config=$root/config/.e2e-modbus-$$.yaml
+# The changed copy of config/modbus-sim.yaml lives in the scratch directory, beside links to
+# config/models and config/plant (its paths are relative to its file).
+config=$out/modbus-sim.yaml
+# shellcheck source=tests/support/scratch_config.sh
+source "$root/tests/support/scratch_config.sh"
+link_shipped_config_dirs "$root" "$out"
 device_pid= daemon_pid=
 cleanup() {
   [ -n "$daemon_pid" ] && kill -KILL "$daemon_pid" 2>/dev/null || true
   [ -n "$device_pid" ] && kill -KILL "$device_pid" 2>/dev/null || true
-  rm -rf "$out" "$config"
+  rm -rf "$out"
 }
 trap cleanup EXIT
 fail() { echo "FAIL: $*" >&2; [ -f "$out/daemon.log" ] && tail -20 "$out/daemon.log" >&2; exit 1; }

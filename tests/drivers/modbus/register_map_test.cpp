@@ -1,6 +1,6 @@
 // Register encoding and decoding (types, word order, scale, offset, range) and the strict
 // reading of the Modbus driver section.
-#include "modbus/register_map.hpp"
+#include "selfsense/drivers/modbus/register_map.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "modbus/modbus_config.hpp"
+#include "selfsense/drivers/modbus/modbus_config.hpp"
 #include "selfsense/io/yaml_map.hpp"
 
 namespace selfsense::drivers::modbus {

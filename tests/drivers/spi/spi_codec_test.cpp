@@ -1,6 +1,6 @@
-// The ADS131M04 and DAC8563 protocols (drivers/spi/ads131m04.hpp, dac8563.hpp): the CRC against
-// its catalogued check value and an independent bit-serial reference, command words against the
-// data sheet's bit patterns, frames, codes and scaling at full scale and one LSB.
+// The ADS131M04 and DAC8563 protocols (include/selfsense/drivers/spi/ads131m04.hpp, dac8563.hpp):
+// the CRC against its catalogued check value and an independent bit-serial reference, command words
+// against the data sheet's bit patterns, frames, codes and scaling at full scale and one LSB.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -10,8 +10,8 @@
 #include <string_view>
 #include <vector>
 
-#include "spi/ads131m04.hpp"
-#include "spi/dac8563.hpp"
+#include "selfsense/drivers/spi/ads131m04.hpp"
+#include "selfsense/drivers/spi/dac8563.hpp"
 
 namespace {
 

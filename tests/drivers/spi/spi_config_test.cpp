@@ -4,15 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "registry/registry.hpp"
 #include "selfsense/daemon/config.hpp"
-#include "spi/spi_driver.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
+#include "selfsense/drivers/spi/spi_driver.hpp"
+#include "support/config_edits.hpp"
 
 namespace {
 
@@ -21,26 +20,12 @@ using selfsense::daemon::load_config;
 using selfsense::drivers::Registry;
 namespace spi = selfsense::drivers::spi;
 
-const std::filesystem::path kConfigDir = std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config";
+const std::filesystem::path kConfigDir = selfsense::test::shipped_config_dir();
 
-ConfigResult load_with(const std::vector<std::pair<std::string, std::string>>& edits,
-                       Registry& registry) {
-  std::ifstream in(kConfigDir / "spi-ads131m04.yaml");
-  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  for (const auto& [from, to] : edits) {
-    const std::size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-  }
-  // One file per test: CTest runs the tests of this program in parallel.
-  std::string file = ".";
-  file += ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  file += ".test-spi.yaml";
-  const std::filesystem::path path = kConfigDir / file;
-  std::ofstream(path) << text;
-  ConfigResult r = load_config(path, &registry);
-  std::filesystem::remove(path);
-  return r;
+// spi-ads131m04.yaml with each (from, to) replaced once, loaded from a scratch directory.
+ConfigResult load_with(const selfsense::test::Edits& edits, Registry& registry) {
+  return selfsense::test::load_shipped_with("spi-ads131m04.yaml", edits, registry,
+                                            ".test-spi.yaml");
 }
 
 std::string joined(const ConfigResult& r) {

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <string>
 
-#include "spi/gpio_line.hpp"
-#include "spi/spi_bus.hpp"
+#include "selfsense/drivers/spi/gpio_line.hpp"
+#include "selfsense/drivers/spi/spi_bus.hpp"
 
 namespace {
 

@@ -20,6 +20,7 @@
 #include "selfsense/runtime/loop.hpp"
 #include "selfsense/runtime/loop_runner.hpp"
 #include "support/daemon_plant.hpp"
+#include "support/shipped_model.hpp"
 #include "support/spi/spi_bench.hpp"
 
 namespace selfsense::test {
@@ -34,13 +35,6 @@ using runtime::LoopState;
 
 constexpr double kRate = 10000.0;
 constexpr double kTs = 1.0 / kRate;
-
-// The daemon's shipped model of this bench (config/models/sim.yaml), as the loop tests use.
-const models::TransducerModel& bench_model() {
-  static const models::TransducerModel m =
-      models::load_model(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config/models/sim.yaml");
-  return m;
-}
 
 runtime::ControllerConfig bench_control() {
   runtime::ControllerConfig c;  // as tests/runtime/loop_test.cpp

@@ -1,6 +1,7 @@
 // An ADS131M04 emulator behind the SpiBus seam, for tests and benches in simulated time.
 //
-// What it does as the data sheet says (drivers/spi/ads131m04.hpp lists the facts):
+// What it does as the data sheet says (include/selfsense/drivers/spi/ads131m04.hpp lists the
+// facts):
 //   - 24-bit words, frames of 6 words; the response word answers the previous frame's command
 //     (NULL: STATUS with DRDY3..0 set for a conversion not yet read); a CRC-16-CCITT word closes
 //     every output frame; with MODE.RX_CRC_EN the input CRC is checked, a mismatch sets
@@ -21,10 +22,10 @@
 #include <functional>
 #include <span>
 
+#include "selfsense/drivers/spi/ads131m04.hpp"
+#include "selfsense/drivers/spi/gpio_line.hpp"
+#include "selfsense/drivers/spi/spi_bus.hpp"
 #include "selfsense/runtime/pacer.hpp"
-#include "spi/ads131m04.hpp"
-#include "spi/gpio_line.hpp"
-#include "spi/spi_bus.hpp"
 
 namespace selfsense::test {
 

@@ -1,6 +1,6 @@
 // A DAC8563 emulator behind the SpiBus seam: decodes every 24-bit frame the way the data sheet
-// defines it (command, address, data; see drivers/spi/dac8563.hpp) into input and DAC
-// registers, power state, LDAC mask and reference, and gives the output voltage the amplifier
+// defines it (command, address, data; see include/selfsense/drivers/spi/dac8563.hpp) into input and
+// DAC registers, power state, LDAC mask and reference, and gives the output voltage the amplifier
 // sees. Frames of another length are counted as malformed and change nothing.
 #pragma once
 
@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <span>
 
-#include "spi/dac8563.hpp"
-#include "spi/spi_bus.hpp"
+#include "selfsense/drivers/spi/dac8563.hpp"
+#include "selfsense/drivers/spi/spi_bus.hpp"
 
 namespace selfsense::test {
 

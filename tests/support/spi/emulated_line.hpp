@@ -1,12 +1,13 @@
-// An emulated GPIO line (drivers/spi/gpio_line.hpp) for tests: an input whose level the test
-// sets (each change queues an edge), or an output whose level the driver sets. wait_edge() does
-// not wait: it takes a queued edge or times out at once (time is the test's to advance).
+// An emulated GPIO line (include/selfsense/drivers/spi/gpio_line.hpp) for tests: an input whose
+// level the test sets (each change queues an edge), or an output whose level the driver sets.
+// wait_edge() does not wait: it takes a queued edge or times out at once (time is the test's to
+// advance).
 #pragma once
 
 #include <cstdint>
 #include <deque>
 
-#include "spi/gpio_line.hpp"
+#include "selfsense/drivers/spi/gpio_line.hpp"
 
 namespace selfsense::test {
 

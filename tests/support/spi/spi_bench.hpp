@@ -9,11 +9,11 @@
 #include <array>
 #include <cmath>
 
+#include "selfsense/drivers/spi/spi_config.hpp"
+#include "selfsense/drivers/spi/spi_driver.hpp"
 #include "selfsense/plant/config.hpp"
 #include "selfsense/plant/plant.hpp"
 #include "selfsense/runtime/pacer.hpp"
-#include "spi/spi_config.hpp"
-#include "spi/spi_driver.hpp"
 #include "support/spi/ads131m04_emulator.hpp"
 #include "support/spi/dac8563_emulator.hpp"
 #include "support/spi/emulated_line.hpp"

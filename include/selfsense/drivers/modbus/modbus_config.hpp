@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "modbus/register_map.hpp"
+#include "selfsense/drivers/modbus/register_map.hpp"
 #include "selfsense/io/yaml_map.hpp"
 
 namespace selfsense::drivers::modbus {

@@ -36,7 +36,7 @@
 #include <string>
 #include <thread>
 
-#include "can/can_config.hpp"
+#include "selfsense/drivers/can/can_config.hpp"
 #include "selfsense/runtime/driver.hpp"
 #include "selfsense/runtime/latency_histogram.hpp"
 #include "selfsense/runtime/latest_value.hpp"

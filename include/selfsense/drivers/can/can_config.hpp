@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "can/can_codec.hpp"
+#include "selfsense/drivers/can/can_codec.hpp"
 #include "selfsense/io/yaml_map.hpp"
 
 namespace selfsense::drivers::can {

@@ -1,7 +1,7 @@
 // The Modbus register map of the transducer: where E, D (and the reference S, T) are read and
 // where the command E is written, and how a value sits in 16-bit registers. Shared by the driver
-// (drivers/modbus/modbus_driver.hpp) and the simulated device (`selfsense sim-device`), so both
-// sides encode with the same code.
+// (include/selfsense/drivers/modbus/modbus_driver.hpp) and the simulated device (`selfsense
+// sim-device`), so both sides encode with the same code.
 //
 // A value is stored as raw = (value - offset) / scale in one register (int16, uint16) or two
 // (int32, float32; `high-first` puts the high word at the lower address, the Modbus custom,

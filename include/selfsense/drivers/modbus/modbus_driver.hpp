@@ -43,7 +43,7 @@
 #include <thread>
 #include <vector>
 
-#include "modbus/modbus_config.hpp"
+#include "selfsense/drivers/modbus/modbus_config.hpp"
 #include "selfsense/runtime/driver.hpp"
 #include "selfsense/runtime/latency_histogram.hpp"
 #include "selfsense/runtime/latest_value.hpp"

@@ -18,6 +18,7 @@
 
 #include "daemon/recording_support.hpp"
 #include "selfsense/daemon/control_client.hpp"
+#include "support/config_edits.hpp"
 #include "support/daemon_process.hpp"
 #include "support/sanitizers.hpp"
 
@@ -68,12 +69,7 @@ inline std::string scratch_config(const std::filesystem::path& dir,
   const auto rate = rate_for_this_build();
   all.insert(all.end(), rate.begin(), rate.end());
   all.insert(all.end(), changes.begin(), changes.end());
-  for (const auto& [from, to] : all) {
-    const std::size_t at = text.find(from);
-    if (at == std::string::npos) throw std::runtime_error("config/sim.yaml has no '" + from + "'");
-    text.replace(at, from.size(), to);
-  }
-  return text;
+  return test::edited(std::move(text), all, "config/sim.yaml");
 }
 
 // selfsensed started (test::DaemonProcess) and answering on its control socket.

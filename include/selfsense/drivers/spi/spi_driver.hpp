@@ -51,15 +51,15 @@
 #include <string>
 #include <thread>
 
+#include "selfsense/drivers/spi/ads131m04.hpp"
+#include "selfsense/drivers/spi/dac8563.hpp"
+#include "selfsense/drivers/spi/gpio_line.hpp"
+#include "selfsense/drivers/spi/spi_bus.hpp"
+#include "selfsense/drivers/spi/spi_config.hpp"
 #include "selfsense/runtime/cycle_trigger.hpp"
 #include "selfsense/runtime/driver.hpp"
 #include "selfsense/runtime/latency_histogram.hpp"
 #include "selfsense/runtime/pacer.hpp"
-#include "spi/ads131m04.hpp"
-#include "spi/dac8563.hpp"
-#include "spi/gpio_line.hpp"
-#include "spi/spi_bus.hpp"
-#include "spi/spi_config.hpp"
 
 namespace selfsense::drivers::spi {
 
