@@ -24,11 +24,10 @@ struct Trial {
 class Judge {
  public:
   Judge(const models::TransducerModel& model, const Signals& s, const ChannelData& ch)
-      : Judge(model, s, ch, model.structure) {}
+      : Judge(s, ch, model.structure) {}
   // Identifies with another structure than the model's (the model's with creep operators).
-  Judge(const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
-        models::Structure structure)
-      : model_(model), s_(s), ch_(ch), structure_(structure), half_(s.drive.size() / 2) {}
+  Judge(const Signals& s, const ChannelData& ch, models::Structure structure)
+      : s_(s), ch_(ch), structure_(structure), half_(s.drive.size() / 2) {}
 
   [[nodiscard]] std::size_t half() const { return half_; }
 
@@ -109,7 +108,6 @@ class Judge {
   }
 
  private:
-  const models::TransducerModel& model_;
   const Signals& s_;
   const ChannelData& ch_;
   models::Structure structure_;
@@ -364,7 +362,7 @@ std::optional<Reidentified> reidentified_creep(const models::TransducerModel& mo
   }
   constexpr models::Structure kWithCreep = models::Structure::kHysteresisCreep;
   const Judge as_is(model, s, ch);
-  const Judge with_creep(model, s, ch, kWithCreep);
+  const Judge with_creep(s, ch, kWithCreep);
   const Trial null = as_is.trial(models::ChannelCorrection{});
   const Trial creep = with_creep.trial(models::ChannelCorrection{});
   const std::optional<double> explains = forecast_explains(null, creep, ch, as_is.half(), options);
