@@ -3,11 +3,13 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "selfsense/identification/nnls.hpp"
 #include "selfsense/identification/operator_fit.hpp"
 #include "selfsense/identification/remanent_state.hpp"
+#include "selfsense/operators/linear_creep.hpp"
 
 namespace selfsense::identification {
 namespace {
@@ -65,7 +67,8 @@ class SideProblem {
     const auto p = static_cast<Eigen::Index>(basis_.columns());
     const Eigen::Index cols = columns();
     std::vector<bool> bounded(static_cast<std::size_t>(cols), false);
-    std::fill_n(bounded.begin(), p, true);
+    // The plays' weights (not the creep lags': a lag may move against its play).
+    std::fill_n(bounded.begin(), static_cast<Eigen::Index>(basis_.plays()), true);
     const auto [y_lo, y_hi] = std::minmax_element(y_.begin(), y_.end());
     const auto [e_lo, e_hi] = std::minmax_element(e_.begin(), e_.end());
     Eigen::VectorXd lower = Eigen::VectorXd::Zero(cols);
@@ -129,7 +132,8 @@ models::StressHysteresisModel fit_stress_hysteresis(std::span<const double> e,
                                                     std::span<const double> t,
                                                     std::span<const double> d,
                                                     std::span<const double> s, double sample_time,
-                                                    std::size_t plays) {
+                                                    std::size_t plays,
+                                                    const StressCreepSizes& creep) {
   const std::size_t n = e.size();
   if (n < 2 || t.size() != n || (!d.empty() && d.size() != n) || (!s.empty() && s.size() != n) ||
       (d.empty() && s.empty())) {
@@ -148,6 +152,19 @@ models::StressHysteresisModel fit_stress_hysteresis(std::span<const double> e,
   for (std::size_t i = 1; i <= plays; ++i) {
     m.basis.thresholds.push_back(0.5 * (*e_hi - *e_lo) * static_cast<double>(i) /
                                  static_cast<double>(plays + 1));
+  }
+  if (creep.eigenvalues > 0) {
+    const double duration = sample_time * static_cast<double>(n);
+    const double fastest = creep.fastest_eigenvalue > 0 ? creep.fastest_eigenvalue
+                                                        : std::min(100.0, 0.1 / sample_time);
+    const double slowest = creep.slowest_eigenvalue > 0 ? creep.slowest_eigenvalue
+                                                        : std::min(3.0 / duration, 0.5 * fastest);
+    m.basis.eigenvalues = operators::log_spaced_eigenvalues(fastest, slowest, creep.eigenvalues);
+    m.basis.creep_rows.push_back(0);
+    const std::size_t extra = std::min(creep.creep_plays, plays);
+    for (std::size_t k = 1; k <= extra; ++k)
+      m.basis.creep_rows.push_back(k * (plays + 1) / (extra + 1));
+    m = models::with_creep_gains(std::move(m));
   }
   // The history shows most clearly in the sensed channel (larger loops, exact charge).
   const SideProblem reference(m.basis, e, t, d.empty() ? s : d);

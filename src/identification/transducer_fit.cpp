@@ -96,7 +96,8 @@ OperatorModel fit_side(const OperatorSignals& s, OperatorStructure structure,
 // strain is recorded; without a sensed channel the strain's output error. The grid of n plays
 // is not nested in that of m > n, and a denser grid matters (a generator off the grid: T_hat
 // 3.8 / 2.4 / 0.11 % on new data with 16 / 24 / 48 plays, docs/identification.md).
-std::size_t choose_stress_plays(const TransducerSignals& s, std::size_t fallback) {
+std::size_t choose_stress_plays(const TransducerSignals& s, std::size_t fallback,
+                                const StressCreepSizes& creep) {
   const std::size_t n = s.drive.size();
   const std::size_t split = n - n / 4;
   const auto head = [split](std::span<const double> v) { return v.empty() ? v : v.first(split); };
@@ -112,7 +113,7 @@ std::size_t choose_stress_plays(const TransducerSignals& s, std::size_t fallback
   if (!varies(head(s.stress)) || !varies(head(s.drive))) return fallback;  // nothing to fit
   for (const std::size_t plays : kStressPlayCandidates) {
     const models::StressHysteresisModel m = fit_stress_hysteresis(
-        head(s.drive), head(s.stress), head(s.sensed), head(s.strain), s.sample_time, plays);
+        head(s.drive), head(s.stress), head(s.sensed), head(s.strain), s.sample_time, plays, creep);
     double score = 0.0;
     if (m.sensor) {
       models::StressHysteresisReconstructor rec(m);
@@ -183,11 +184,13 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
     if (signals.stress.empty()) {
       throw std::invalid_argument("identify: stress-hysteresis needs a stress channel (T or F)");
     }
+    const StressCreepSizes creep{options.eigenvalues, options.creep_plays,
+                                 options.fastest_eigenvalue, options.slowest_eigenvalue};
     const std::size_t plays = options.choose_plays && n >= 8
-                                  ? choose_stress_plays(signals, options.plays)
+                                  ? choose_stress_plays(signals, options.plays, creep)
                                   : options.plays;
     model.vectorial = fit_stress_hysteresis(signals.drive, signals.stress, signals.sensed,
-                                            signals.strain, signals.sample_time, plays);
+                                            signals.strain, signals.sample_time, plays, creep);
     return model;
   }
   std::vector<std::span<const double>> linear;

@@ -104,6 +104,11 @@ StressHysteresisModel read_vectorial(YamlMap& root, double ts) {
   m.sample_time = ts;
   v.read_sequence("thresholds", m.basis.thresholds);
   v.read_sequence("history", m.history);
+  if (std::optional<YamlMap> creep = v.optional_map("creep")) {
+    creep->read_sequence("rows", m.basis.creep_rows);
+    creep->read_sequence("eigenvalues", m.basis.eigenvalues);
+    creep->finish();
+  }
   std::vector<double> range;
   v.read_sequence("stress_range", range);
   if (range.size() != 2) v.fail("stress_range", "expected [min, max]");
@@ -295,6 +300,15 @@ void emit_vectorial(YAML::Emitter& out, const StressHysteresisModel& m) {
   out << YAML::Key << "vectorial" << YAML::Value << YAML::BeginMap;
   emit_sequence(out, "thresholds", m.basis.thresholds);
   emit_sequence(out, "history", m.history);
+  if (!m.basis.eigenvalues.empty()) {
+    out << YAML::Key << "creep" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "rows" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (const std::size_t r : m.basis.creep_rows)
+      out << r;
+    out << YAML::EndSeq;
+    emit_sequence(out, "eigenvalues", m.basis.eigenvalues);
+    out << YAML::EndMap;
+  }
   emit_sequence(out, "stress_range", {m.stress_min, m.stress_max});
   for (const auto& [name, side] :
        {std::pair{"sensor", &m.sensor}, std::pair{"actuator", &m.actuator}}) {

@@ -114,6 +114,9 @@ std::uint64_t parameter_hash(const TransducerModel& model) noexcept {
   if (model.vectorial) {
     const StressHysteresisModel& v = *model.vectorial;
     h.add(v.basis.thresholds);
+    h.add(v.basis.eigenvalues);
+    for (const std::size_t r : v.basis.creep_rows)
+      h.add(static_cast<std::uint64_t>(r));
     h.add(v.history);
     h.add(v.stress_min);
     h.add(v.stress_max);

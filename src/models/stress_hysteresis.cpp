@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "selfsense/operators/kernels.hpp"
@@ -28,16 +29,33 @@ bool StressHysteresisModel::is_valid(std::string* why) const {
           "vectorial.thresholds", std::span(basis.thresholds).subspan(1), 0.0, why)) {
     return false;
   }
-  if (!basis.creep_rows.empty()) return fail("vectorial: creep is not part of this model");
+  if (!basis.hinge_rows.empty()) return fail("vectorial: hinges are not part of this model");
+  for (std::size_t i = 0; i < basis.creep_rows.size(); ++i) {
+    if (basis.creep_rows[i] >= basis.plays() ||
+        (i > 0 && basis.creep_rows[i] <= basis.creep_rows[i - 1])) {
+      return fail("vectorial.creep.rows: must be increasing play indices below " +
+                  std::to_string(basis.plays()));
+    }
+  }
+  if (basis.creep_rows.empty() != basis.eigenvalues.empty()) {
+    return fail("vectorial.creep: rows and eigenvalues must both be given or both be empty");
+  }
+  for (const double l : basis.eigenvalues) {
+    if (!(l > 0.0) || !std::isfinite(l)) {
+      return fail("vectorial.creep.eigenvalues: must be finite and > 0");
+    }
+  }
   if (!(stress_max > stress_min)) return fail("vectorial.stress_range: max must be > min");
   for (const auto& [name, side] :
        {std::pair{"sensor", &sensor}, std::pair{"actuator", &actuator}}) {
     if (!*side) continue;
     const std::string prefix = std::string("vectorial.") + name;
-    if (!operators::check::same_size(prefix + ".base", (*side)->base.size(), "vectorial.thresholds",
-                                     basis.plays(), why) ||
-        !operators::check::same_size(prefix + ".stress", (*side)->stress.size(),
-                                     "vectorial.thresholds", basis.plays(), why) ||
+    const char* columns =
+        basis.creep() > 0 ? "vectorial's plays and creep lags" : "vectorial.thresholds";
+    if (!operators::check::same_size(prefix + ".base", (*side)->base.size(), columns,
+                                     basis.columns(), why) ||
+        !operators::check::same_size(prefix + ".stress", (*side)->stress.size(), columns,
+                                     basis.columns(), why) ||
         !operators::check::all_finite(prefix + ".base", (*side)->base, why) ||
         !operators::check::all_finite(prefix + ".stress", (*side)->stress, why) ||
         !operators::check::finite(prefix + ".linear", (*side)->linear, why) ||
@@ -49,8 +67,15 @@ bool StressHysteresisModel::is_valid(std::string* why) const {
   return true;
 }
 
+StressHysteresisModel with_creep_gains(StressHysteresisModel model) {
+  model.basis.gains.clear();
+  for (const double l : model.basis.eigenvalues)
+    model.basis.gains.push_back(-std::expm1(-l * model.sample_time));
+  return model;
+}
+
 StressHysteresisForward::StressHysteresisForward(StressHysteresisModel model)
-    : model_(std::move(model)), stream_(model_.basis, model_.history) {}
+    : model_(with_creep_gains(std::move(model))), stream_(model_.basis, model_.history) {}
 
 StressHysteresisForward::Output StressHysteresisForward::step(double e, double t) noexcept {
   const std::span<const double> q = stream_.next(e);
@@ -95,7 +120,7 @@ StressSolution solve_quadratic_stress(double a, double b, double c, double d, do
 }  // namespace
 
 StressHysteresisReconstructor::StressHysteresisReconstructor(StressHysteresisModel model)
-    : model_(std::move(model)), stream_(model_.basis, model_.history) {
+    : model_(with_creep_gains(std::move(model))), stream_(model_.basis, model_.history) {
   if (!model_.sensor) {
     throw std::invalid_argument("stress-hysteresis reconstruction needs a sensor side");
   }

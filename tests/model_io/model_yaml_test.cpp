@@ -87,6 +87,28 @@ TEST(ModelYaml, VectorialModelRoundTrips) {
   expect_error(broken, "stress_range");
 }
 
+// With creep lags among its columns: the rows and eigenvalues come back, the gains follow from
+// them at the model's rate, and rows beyond the plays are refused by key.
+TEST(ModelYaml, VectorialModelWithCreepRoundTrips) {
+  const test::TransducerData d = test::transducer_data(test::typical_transducer(1e-3), 3000, 0, 4);
+  TransducerModel m;
+  m.structure = Structure::kStressHysteresis;
+  m.sample_time = 1e-3;
+  m.vectorial = fit_stress_hysteresis(d.e, d.t, d.d, d.s, 1e-3, 6, {3, 1, 0.0, 0.0});
+  ASSERT_EQ(m.vectorial->basis.creep(), 6U);
+  ASSERT_EQ(m.vectorial->sensor->base.size(), 7U + 6U);
+  const std::string text = model_to_string(m);
+  const TransducerModel back = model_from_string(text);
+  ASSERT_TRUE(back.vectorial.has_value());
+  EXPECT_EQ(back.vectorial->basis.creep_rows, m.vectorial->basis.creep_rows);
+  EXPECT_EQ(back.vectorial->basis.eigenvalues, m.vectorial->basis.eigenvalues);
+  EXPECT_EQ(back.vectorial->sensor->base, m.vectorial->sensor->base);
+  EXPECT_EQ(model_to_string(back), text);
+  std::string broken = text;
+  broken.replace(broken.find("rows: [0, "), 10, "rows: [0, 9");
+  expect_error(broken, "vectorial.creep.rows");
+}
+
 TEST(ModelYaml, MinimalModelLoads) {
   const TransducerModel m = model_from_string(kMinimal);
   EXPECT_FALSE(m.actuator.has_value());

@@ -113,6 +113,67 @@ TEST(StressHysteresis, ReconstructsStressWhereTheAffineModelCannot) {
   EXPECT_EQ(vectorial.status_counts()[SampleStatus::kOk], r.e.size());
 }
 
+// The same stack with the plant's creep and the field held for 3 s of every 8 (the load keeps
+// moving): the polarization and the strain creep during the holds, which plays cannot follow.
+Recorded stressed_stack_with_holds() {
+  plant::PlantConfig config = test::stressed_stack(1000.0, 7e-6);
+  config.creep.enabled = true;
+  plant::Plant p(config);
+  Recorded r;
+  double e = 1e6;
+  for (int k = 0; k < 60000; ++k) {
+    const double time = k * 1e-3;
+    if (std::fmod(time, 8.0) < 5.0) {
+      e = 1e6 + 0.9e6 * std::sin(2 * std::numbers::pi * 1.1 * time) *
+                    std::cos(2 * std::numbers::pi * 0.07 * time);
+    }
+    const double f = 700.0 * std::sin(2 * std::numbers::pi * 0.37 * time);
+    const plant::StepOutput out = p.step({e, f, 25.0});
+    r.e.push_back(out.e_meas_v_per_m);
+    r.d.push_back(out.d_meas_c_per_m2);
+    r.s.push_back(out.s);
+    r.t.push_back(out.t_pa);
+  }
+  return r;
+}
+
+TEST(StressHysteresis, CreepLagsAmongTheColumnsFollowTheCreepDuringHolds) {
+  const Recorded r = stressed_stack_with_holds();
+  constexpr std::size_t kSplit = 40000;
+  const auto head = [](const std::vector<double>& v) { return std::span(v).first(kSplit); };
+  const auto held_out = [&r](const StressHysteresisModel& m) {
+    StressHysteresisReconstructor rec(m);
+    std::vector<double> t_hat;
+    std::vector<double> s_hat;
+    for (std::size_t k = 0; k < r.e.size(); ++k) {
+      const auto est = rec.step(r.e[k], r.d[k]);
+      if (k < kSplit) continue;
+      t_hat.push_back(est.stress);
+      s_hat.push_back(est.strain);
+    }
+    return std::pair{fit_quality(std::span(r.t).subspan(kSplit), t_hat).nrmse,
+                     fit_quality(std::span(r.s).subspan(kSplit), s_hat).nrmse};
+  };
+  const auto [t_plain, s_plain] =
+      held_out(fit_stress_hysteresis(head(r.e), head(r.t), head(r.d), head(r.s), 1e-3, 24));
+  // Six lags on the play of threshold 0, as hysteresis-creep's defaults (creep plays made it
+  // worse here: T_hat 1.87 %, S_hat 1.08 % with two).
+  const StressHysteresisModel creeping =
+      fit_stress_hysteresis(head(r.e), head(r.t), head(r.d), head(r.s), 1e-3, 24, {6, 0, 0.0, 0.0});
+  EXPECT_EQ(creeping.basis.creep(), 6U);
+  const auto [t_creep, s_creep] = held_out(creeping);
+  std::printf("held out: T_hat %.3f %% -> %.3f %%, S_hat %.3f %% -> %.3f %% with creep lags\n",
+              100 * t_plain, 100 * t_creep, 100 * s_plain, 100 * s_creep);
+  // Measured: T_hat 1.479 -> 1.410 %, S_hat 0.768 -> 0.735 %: the lags follow the creep of
+  // the field's response; the plant's creep also follows the stress's response, which no lag of
+  // the field can (docs/identification.md). Deterministic, so the small gain is asserted as a
+  // gain, and each figure within 1.1x.
+  EXPECT_LT(t_creep, t_plain);
+  EXPECT_LT(s_creep, s_plain);
+  EXPECT_LT(t_creep, 1.1 * 0.01410);
+  EXPECT_LT(s_creep, 1.1 * 0.00735);
+}
+
 // A model whose sensor side is D = a + b T + c T^2 with a = E (one linear play, weight 1) and
 // b, c given: the closed-form reconstruction against the exact answer.
 StressHysteresisModel quadratic_model(double b, double c, double lo, double hi) {

@@ -31,9 +31,10 @@ struct IdentificationOptions {
   // worse).
   bool choose_bias_levels{false};
   bool choose_dead_zones{false};
-  // stress-hysteresis chooses its play count among kStressPlayCandidates on the fitting data
-  // alone: the reconstruction error (T_hat, and S_hat with a strain channel) on the last
-  // quarter of a fit on the first three quarters.
+  // stress-hysteresis takes eigenvalues and creep_plays as creep lags among its columns
+  // (stress_hysteresis_fit.hpp; default none) and chooses its play count among
+  // kStressPlayCandidates on the fitting data alone: the reconstruction error (T_hat, and S_hat
+  // with a strain channel) on the last quarter of a fit on the first three quarters.
   bool choose_plays{false};
 };
 inline constexpr std::array<std::size_t, 4> kBiasLevelCandidates{0, 1, 3, 7};

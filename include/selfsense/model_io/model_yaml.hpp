@@ -20,6 +20,7 @@
 //   vectorial:                           # structure stress-hysteresis instead of the sides:
 //     thresholds: [0, ...]               #   D = base.q + T stress.q + linear T
 //     history: [...]                     #       + quadratic T^2 + offset
+//     creep: {rows: [0, ...], eigenvalues: [...]}   # optional: q holds creep lags too
 //     stress_range: [min, max]           #   (stress_hysteresis.hpp); bracket of the solver
 //     sensor: {base, stress, linear, quadratic, offset}
 //     actuator: {base, stress, linear, quadratic, offset}

@@ -1,6 +1,8 @@
 // Stress-dependent hysteresis: the vectorial case of section 3.3 that the paper leaves as
 // future work, in a form that stays linear in its parameters. With q(E) the play columns of the
-// field history (operators/regressor_stream.hpp: H[E] = W . q),
+// field history and, optionally, the creep lags on some of them (operators/regressor_stream.hpp:
+// H[E] + K[E] = W . q; lag j of play i: z[k] = z[k-1] + a_j (p_i[k] - z[k-1]), a_j = 1 -
+// exp(-lambda_j Ts)),
 //   D = W0 . q + T (W1 . q) + d1 T + d2 T^2 + D0       sensor side
 //   S = A0 . q + T (A1 . q) + s1 T + s2 T^2 + S0       actuator side
 // so coupling, permittivity and hysteresis amplitude all change with stress. D is no longer
@@ -40,17 +42,23 @@ struct StressHysteresisSide {
 
 struct StressHysteresisModel {
   double sample_time{0.0};
-  operators::OperatorBasis basis{};  // plays only (no creep)
-  std::vector<double> history{};     // field turning points before the first sample
+  // Plays, and creep lags (eigenvalues on creep_rows) if any; no hinges. The gains a_j follow
+  // from the eigenvalues and sample_time (with_creep_gains), so a model runs at any rate.
+  operators::OperatorBasis basis{};
+  std::vector<double> history{};  // field turning points before the first sample
   std::optional<StressHysteresisSide> sensor{};
   std::optional<StressHysteresisSide> actuator{};
   double stress_min{0.0};  // reconstruction bracket [Pa]
   double stress_max{0.0};
 
-  // Thresholds start at 0 and increase, every side has one weight per play, the bracket is
-  // ordered; names the field ("vectorial.sensor.base has 3 elements ...").
+  // Thresholds start at 0 and increase, creep rows name plays in increasing order and
+  // eigenvalues are positive, every side has one weight per column (plays, then lags), the
+  // bracket is ordered; names the field ("vectorial.sensor.base has 3 elements ...").
   [[nodiscard]] bool is_valid(std::string* why) const;
 };
+
+// The model with basis.gains derived from its eigenvalues and sample_time (a_j above).
+[[nodiscard]] StressHysteresisModel with_creep_gains(StressHysteresisModel model);
 
 // Per-sample forward model (E, T -> D, S); allocation-free after construction.
 class StressHysteresisForward final {
