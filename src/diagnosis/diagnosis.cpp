@@ -53,6 +53,190 @@ Unexplained unexplained_in(const std::string& channel, const std::vector<double>
   return u;
 }
 
+// What every pass of the diagnosis reads.
+struct Context {
+  const models::TransducerModel& model;
+  const models::TransducerModel& base;  // the model without its corrections
+  const Signals& signals;
+  const Options& options;
+  std::size_t blocks{0};
+  bool field{true};
+  bool has_sensor{false};
+};
+
+// The diagnosis proper, on the base's outputs or, with `stressed`, on the stress-hysteresis
+// model that replaced it: each channel's rounds and re-identifications, and the verdict.
+Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Outputs outputs,
+                         const std::optional<StressReidentified>& stressed) {
+  const models::TransducerModel& model = c.model;
+  const Signals& s = c.signals;
+  const Options& options = c.options;
+  const std::size_t n = s.drive.size();
+  const std::size_t blocks = c.blocks;
+  const bool field = c.field;
+  const bool has_sensor = c.has_sensor;
+  Result result;
+  result.improved = c.base;
+  if (stressed) {
+    result.improved = stressed->model;
+    outputs = stressed->outputs;
+  }
+  // The channels hold their own copies; the electrostriction term reads the sensed channel's
+  // response to the drive alone (D - d T: the polarization and the dielectric part).
+  static_cast<void>(hold_finite(outputs.sensed));
+  const std::vector<double> sensed_response =
+      response_to_drive(outputs.sensed, stressed ? 0.0 : coupling_of(model.sensor), s.stress);
+
+  const std::vector<Segment> drive_holds = holds_of(s.drive);
+  for (ChannelData& ch : channels) {
+    const Rows rows = make_rows(hold_finite(ch.base), blocks);
+    ch.sensed_model = sensed_response;
+    const std::vector<double> model_output = ch.base;  // for the figures before
+    std::vector<Finding> stress_found;
+    if (stressed) {
+      ch.base = ch.sensed ? outputs.sensed : outputs.strain;
+      static_cast<void>(hold_finite(ch.base));
+      ch.coupling = 0.0;
+      ch.affine = false;
+      for (const Finding& f : stressed->named) {
+        if (f.channel == ch.name) stress_found.push_back(f);
+      }
+    }
+    // The rounds on one base output of the channel, with an effect found by re-identification
+    // (reidentified.hpp) accepted first when given.
+    const auto search = [&](const std::optional<Reidentified>& reid, std::vector<Finding>& found) {
+      if (reid) ch.base = reid->base;
+      identification::CorrectionSignals cs;
+      cs.y = ch.base;
+      cs.recorded = ch.recorded;
+      cs.drive = s.drive;
+      cs.stress = s.stress;
+      cs.temperature = s.temperature;
+      cs.sensed = has_sensor ? std::span<const double>(sensed_response) : std::span<const double>();
+      const std::vector<double> response = response_to_drive(ch.base, ch.coupling, s.stress);
+      cs.response = response;
+      cs.sample_time = s.sample_time;
+      if (!s.temperature.empty()) cs.temperature_reference_degc = s.temperature[0];
+      SearchState st;
+      st.current = ch.base;
+      st.original_sse = sse_over(ch.recorded, model_output, rows.judge);
+      if (reid) {
+        st.accepted = reid->correction;
+        st.accepted_terms = reid->terms;
+        st.used.push_back(reid->candidate);
+        st.current = reid->output;
+        found.push_back(reid->finding);
+      }
+      st.current_sse = sse_over(ch.recorded, st.current, rows.judge);
+      const SearchInput in{ch, cs, s, rows, drive_holds, has_sensor, !field, options};
+      search_rounds(in, st, found);
+      local_pass(in, st, found);
+      absorbed_pass(in, st, found);
+      return st;
+    };
+    const auto accept_side = [&](const Reidentified& reid) {
+      (ch.sensed ? result.improved.sensor : result.improved.actuator) = reid.side;
+      if (reid.structure) result.improved.structure = *reid.structure;
+    };
+    // A stack that warmed bends a base identified on it (its creep and loop follow the drift):
+    // where the temperature moved, the channel's side is re-identified with the temperature's
+    // terms, and if that forecasts better the rounds run on it.
+    const std::optional<Reidentified> warmed =
+        stressed ? std::nullopt : reidentified_temperature(model, s, ch, model_output, options);
+    if (warmed) accept_side(*warmed);
+    std::vector<Finding> found;
+    SearchState st = search(warmed, found);
+    found.insert(found.begin(), stress_found.begin(), stress_found.end());
+    bool reidentified = warmed.has_value() || stressed.has_value();
+    // The rounds again on a re-identified side; `kept` goes before what they find.
+    const auto search_again = [&](const Reidentified& reid, std::vector<Finding> kept) {
+      std::vector<Finding> again;
+      st = search(reid, again);
+      kept.insert(kept.end(), std::make_move_iterator(again.begin()),
+                  std::make_move_iterator(again.end()));
+      found = std::move(kept);
+      accept_side(reid);
+      reidentified = true;
+    };
+    // A loop identified on a creeping stack bends to the creep: on a model without creep
+    // operators, where the rounds name creep or nothing on the channel, the structure with them
+    // is judged by re-identification.
+    const auto named_only = [&](std::string_view effect) {
+      return std::all_of(found.begin(), found.end(),
+                         [&](const Finding& f) { return f.effect == effect; });
+    };
+    models::TransducerModel structure = model;  // the structure the leak is judged with
+    std::vector<Finding> creep_found;
+    if (!reidentified && named_only("creep")) {
+      std::optional<Reidentified> creep = reidentified_creep(model, s, ch, model_output, options);
+      if (creep) {
+        structure.structure = *creep->structure;
+        creep_found = {creep->finding};
+        search_again(*creep, {});
+      }
+    }
+    // A base identified on a recording with a leak has bent its own operators to it: when the
+    // rounds name nothing on the sensed channel (or only the creep just re-identified), the leak
+    // is judged by re-identification with the structure as it now stands, and if it holds the
+    // rounds run again on the re-identified sensor side. Not where the rounds name creep on a
+    // structure without creep operators: such a model forecasts a creeping stack better with any
+    // drift, a leak included (the disc's polarization creep during holds, real.evaluate).
+    const bool after_creep = !creep_found.empty() && named_only("creep");
+    if (ch.sensed && !stressed && (found.empty() || after_creep)) {
+      std::optional<Reidentified> leak = reidentified_leak(structure, s, ch, model_output, options);
+      if (leak) search_again(*leak, creep_found);
+    }
+    // A channel sampled late bends the base the same way (its fastest lags follow the lag, so a
+    // delay fitted after it wins on fast blocks and loses on slow ones): where a lag explained
+    // min_explains of the held-out residual in the first round and the rounds named nothing
+    // but lags on the whole record, the delay is judged by re-identification.
+    const bool only_lags = std::all_of(found.begin(), found.end(), [](const Finding& f) {
+      return f.effect == "delay" || f.effect == "dynamics";
+    });
+    if (!reidentified && (st.rounds_named == 0 || only_lags) &&
+        st.lag_explains >= options.min_explains) {
+      std::optional<Reidentified> late = reidentified_delay(model, s, ch, model_output, options);
+      if (late) search_again(*late, {});
+    }
+    result.findings.insert(result.findings.end(), std::make_move_iterator(found.begin()),
+                           std::make_move_iterator(found.end()));
+
+    ChannelResult out;
+    out.channel = ch.name;
+    out.recorded.assign(ch.recorded.begin(), ch.recorded.end());
+    out.before = model_output;
+    out.after = st.current;
+    std::vector<double> residual(n);
+    std::vector<double> residual_after(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      residual[k] = ch.recorded[k] - model_output[k];
+      residual_after[k] = ch.recorded[k] - st.current[k];
+    }
+    out.located = large_segments(residual, 1.5, 8);
+    out.noise_floor = noise_floor(residual);
+    out.residual_rms = rms(residual_after);
+    const bool named = std::any_of(result.findings.begin(), result.findings.end(),
+                                   [&](const Finding& f) { return f.channel == ch.name; });
+    if (!named && out.residual_rms > options.unexplained_ratio * out.noise_floor) {
+      result.unexplained.push_back(unexplained_in(ch.name, residual_after, out.noise_floor));
+    }
+    out.test_before = correlation_test(residual, s.drive);
+    out.test_after = correlation_test(residual_after, s.drive);
+    result.channels.push_back(std::move(out));
+    if (!st.accepted.empty()) {
+      (ch.sensed ? result.improved.sensed_correction : result.improved.strain_correction) =
+          st.accepted;
+    }
+  }
+  result.mismatch = !result.findings.empty();
+  if (result.mismatch) {
+    result.verdict = Verdict::kMismatch;
+  } else if (!result.unexplained.empty()) {
+    result.verdict = Verdict::kUnexplained;
+  }
+  return result;
+}
+
 }  // namespace
 
 const char* to_string(Verdict v) noexcept {
@@ -123,151 +307,24 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
   }
 
   const std::size_t blocks = std::max<std::size_t>(2, options.blocks);
-  // The channels hold their own copies; the electrostriction term reads the sensed channel's
-  // response to the drive alone (D - d T: the polarization and the dielectric part).
-  static_cast<void>(hold_finite(outputs.sensed));
-  const std::vector<double> sensed_response =
-      response_to_drive(outputs.sensed, coupling_of(model.sensor), s.stress);
-
-  const std::vector<Segment> drive_holds = holds_of(s.drive);
-  Result result;
-  result.improved = base;
-  for (ChannelData& ch : channels) {
-    const Rows rows = make_rows(hold_finite(ch.base), blocks);
-    ch.sensed_model = sensed_response;
-    const std::vector<double> model_output = ch.base;  // for the figures before
-    // The rounds on one base output of the channel, with an effect found by re-identification
-    // (reidentified.hpp) accepted first when given.
-    const auto search = [&](const std::optional<Reidentified>& reid, std::vector<Finding>& found) {
-      if (reid) ch.base = reid->base;
-      identification::CorrectionSignals cs;
-      cs.y = ch.base;
-      cs.recorded = ch.recorded;
-      cs.drive = s.drive;
-      cs.stress = s.stress;
-      cs.temperature = s.temperature;
-      cs.sensed = has_sensor ? std::span<const double>(sensed_response) : std::span<const double>();
-      const std::vector<double> response = response_to_drive(ch.base, ch.coupling, s.stress);
-      cs.response = response;
-      cs.sample_time = s.sample_time;
-      if (!s.temperature.empty()) cs.temperature_reference_degc = s.temperature[0];
-      SearchState st;
-      st.current = ch.base;
-      st.original_sse = sse_over(ch.recorded, model_output, rows.judge);
-      if (reid) {
-        st.accepted = reid->correction;
-        st.accepted_terms = reid->terms;
-        st.used.push_back(reid->candidate);
-        st.current = reid->output;
-        found.push_back(reid->finding);
-      }
-      st.current_sse = sse_over(ch.recorded, st.current, rows.judge);
-      const SearchInput in{ch, cs, s, rows, drive_holds, has_sensor, !field, options};
-      search_rounds(in, st, found);
-      local_pass(in, st, found);
-      absorbed_pass(in, st, found);
-      return st;
-    };
-    const auto accept_side = [&](const Reidentified& reid) {
-      (ch.sensed ? result.improved.sensor : result.improved.actuator) = reid.side;
-      if (reid.structure) result.improved.structure = *reid.structure;
-    };
-    // A stack that warmed bends a base identified on it (its creep and loop follow the drift):
-    // where the temperature moved, the channel's side is re-identified with the temperature's
-    // terms, and if that forecasts better the rounds run on it.
-    const std::optional<Reidentified> warmed =
-        reidentified_temperature(model, s, ch, model_output, options);
-    if (warmed) accept_side(*warmed);
-    std::vector<Finding> found;
-    SearchState st = search(warmed, found);
-    bool reidentified = warmed.has_value();
-    // The rounds again on a re-identified side; `kept` goes before what they find.
-    const auto search_again = [&](const Reidentified& reid, std::vector<Finding> kept) {
-      std::vector<Finding> again;
-      st = search(reid, again);
-      kept.insert(kept.end(), std::make_move_iterator(again.begin()),
-                  std::make_move_iterator(again.end()));
-      found = std::move(kept);
-      accept_side(reid);
-      reidentified = true;
-    };
-    // A loop identified on a creeping stack bends to the creep: on a model without creep
-    // operators, where the rounds name creep or nothing on the channel, the structure with them
-    // is judged by re-identification.
-    const auto named_only = [&](std::string_view effect) {
-      return std::all_of(found.begin(), found.end(),
-                         [&](const Finding& f) { return f.effect == effect; });
-    };
-    models::TransducerModel structure = model;  // the structure the leak is judged with
-    std::vector<Finding> creep_found;
-    if (!reidentified && named_only("creep")) {
-      std::optional<Reidentified> creep = reidentified_creep(model, s, ch, model_output, options);
-      if (creep) {
-        structure.structure = *creep->structure;
-        creep_found = {creep->finding};
-        search_again(*creep, {});
-      }
-    }
-    // A base identified on a recording with a leak has bent its own operators to it: when the
-    // rounds name nothing on the sensed channel (or only the creep just re-identified), the leak
-    // is judged by re-identification with the structure as it now stands, and if it holds the
-    // rounds run again on the re-identified sensor side. Not where the rounds name creep on a
-    // structure without creep operators: such a model forecasts a creeping stack better with any
-    // drift, a leak included (the disc's polarization creep during holds, real.evaluate).
-    const bool after_creep = !creep_found.empty() && named_only("creep");
-    if (ch.sensed && (found.empty() || after_creep)) {
-      std::optional<Reidentified> leak = reidentified_leak(structure, s, ch, model_output, options);
-      if (leak) search_again(*leak, creep_found);
-    }
-    // A channel sampled late bends the base the same way (its fastest lags follow the lag, so a
-    // delay fitted after it wins on fast blocks and loses on slow ones): where a lag explained
-    // min_explains of the held-out residual in the first round and the rounds named nothing
-    // but lags on the whole record, the delay is judged by re-identification.
-    const bool only_lags = std::all_of(found.begin(), found.end(), [](const Finding& f) {
-      return f.effect == "delay" || f.effect == "dynamics";
-    });
-    if (!reidentified && (st.rounds_named == 0 || only_lags) &&
-        st.lag_explains >= options.min_explains) {
-      std::optional<Reidentified> late = reidentified_delay(model, s, ch, model_output, options);
-      if (late) search_again(*late, {});
-    }
-    result.findings.insert(result.findings.end(), std::make_move_iterator(found.begin()),
-                           std::make_move_iterator(found.end()));
-
-    ChannelResult out;
-    out.channel = ch.name;
-    out.recorded.assign(ch.recorded.begin(), ch.recorded.end());
-    out.before = model_output;
-    out.after = st.current;
-    std::vector<double> residual(n);
-    std::vector<double> residual_after(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      residual[k] = ch.recorded[k] - model_output[k];
-      residual_after[k] = ch.recorded[k] - st.current[k];
-    }
-    out.located = large_segments(residual, 1.5, 8);
-    out.noise_floor = noise_floor(residual);
-    out.residual_rms = rms(residual_after);
-    const bool named = std::any_of(result.findings.begin(), result.findings.end(),
-                                   [&](const Finding& f) { return f.channel == ch.name; });
-    if (!named && out.residual_rms > options.unexplained_ratio * out.noise_floor) {
-      result.unexplained.push_back(unexplained_in(ch.name, residual_after, out.noise_floor));
-    }
-    out.test_before = correlation_test(residual, s.drive);
-    out.test_after = correlation_test(residual_after, s.drive);
-    result.channels.push_back(std::move(out));
-    if (!st.accepted.empty()) {
-      (ch.sensed ? result.improved.sensed_correction : result.improved.strain_correction) =
-          st.accepted;
-    }
-  }
-  result.mismatch = !result.findings.empty();
-  if (result.mismatch) {
-    result.verdict = Verdict::kMismatch;
-  } else if (!result.unexplained.empty()) {
-    result.verdict = Verdict::kUnexplained;
-  }
-  return result;
+  const Context context{model, base, s, options, blocks, field, has_sensor};
+  Result first = diagnose_channels(context, channels, outputs, std::nullopt);
+  const auto is_stress = [](const Finding& f) { return f.effect == "stress_dependence"; };
+  if (!std::all_of(first.findings.begin(), first.findings.end(), is_stress)) return first;
+  // A loop and coupling that move with the stress bend an affine base: where nothing but the
+  // stress is named, judged for the whole model (it replaces both sides) by re-identification
+  // with the stress-hysteresis structure. It is taken where it names the stress on a channel
+  // the corrections did not (they carry the coupling's change on S, not the permittivity's and
+  // the loop's on D); then each channel's rounds run on it and no side is re-identified again.
+  const std::optional<StressReidentified> stressed =
+      reidentified_stress(model, s, channels, options);
+  if (!stressed) return first;
+  const bool adds_a_channel =
+      std::any_of(stressed->named.begin(), stressed->named.end(), [&](const Finding& f) {
+        return std::none_of(first.findings.begin(), first.findings.end(),
+                            [&](const Finding& g) { return g.channel == f.channel; });
+      });
+  return adds_a_channel ? diagnose_channels(context, channels, outputs, stressed) : first;
 }
 
 }  // namespace selfsense::diagnosis

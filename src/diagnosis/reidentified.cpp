@@ -151,15 +151,14 @@ models::ChannelCorrection scaled(models::ChannelCorrection c, double factor) {
   return c;
 }
 
-// The first candidate that carries `term`.
+}  // namespace
+
 const Candidate& candidate_using(CorrectionTerm term) {
   for (const Candidate& c : candidates()) {
     if (uses_term(c, term)) return c;
   }
   throw std::logic_error("reidentified: no candidate carries the term");
 }
-
-}  // namespace
 
 Rows forecast_rows(std::size_t n, std::size_t half, std::size_t judging,
                    const std::vector<double>& a, const std::vector<double>& b) {

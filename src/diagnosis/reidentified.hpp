@@ -78,6 +78,28 @@ struct Reidentified {
                                                              const std::vector<double>& current,
                                                              const Options& options);
 
+// Stress dependence judged by re-identification with the stress-hysteresis structure
+// (docs/diagnose.md, "Stress dependence re-identified"): a stack whose permittivity, coupling
+// and loop size move with the stress bends an affine base to it, and no correction after it
+// carries to new loads. The null is the model's structure identified on the first half of both
+// channels, the candidate `stress-hysteresis` (D or S = W0.q + T W1.q + d1 T + d2 T^2, the plays
+// of the field: loop and permittivity scaled by T, coupling quadratic in T) identified there too;
+// each channel where it forecasts the second half better by forecast_explains is named, and no
+// channel may forecast worse (the structure replaces both sides). The improved model is that
+// structure identified on the whole record.
+struct StressReidentified {
+  models::TransducerModel model{};  // stress-hysteresis, identified on the whole record
+  Outputs outputs{};                // its D and S over the record
+  std::vector<Finding> named{};     // one per channel where the forecast wins
+};
+
+[[nodiscard]] std::optional<StressReidentified> reidentified_stress(
+    const models::TransducerModel& model, const Signals& s,
+    const std::vector<ChannelData>& channels, const Options& options);
+
+// The first candidate that carries `term`.
+[[nodiscard]] const Candidate& candidate_using(identification::CorrectionTerm term);
+
 // A delay on either channel judged the same way (docs/diagnose.md, "Delay re-identified"): a
 // base identified on a channel sampled late bends its fastest creep lags to the lag, and a delay
 // fitted after it then doubles what they already imitate where the drive is slow. The channel is
