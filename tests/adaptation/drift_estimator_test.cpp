@@ -158,6 +158,29 @@ TEST(DriftEstimator, LearnsNothingOnHoldsRejectedSamplesOrWhenFrozen) {
   EXPECT_EQ(est.drift().permittivity, before.permittivity);
 }
 
+// The loop's own rejections (runtime/loop.hpp): a sample estimated with learn = false and a
+// sample skipped (a driver fault) each leave the estimator without an anchor, so no increment
+// spans them; the same field steps without them update every time.
+TEST(AdaptedReconstruction, LearnsNothingAcrossSamplesTheLoopRejects) {
+  const Drifted data = drifted(0.08, -0.08, 0.04, 4000, 7);
+  AdaptedReconstruction plain(data.model, DriftEstimatorConfig{});
+  AdaptedReconstruction gated(data.model, DriftEstimatorConfig{});
+  AdaptedReconstruction skipped(data.model, DriftEstimatorConfig{});
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    static_cast<void>(plain.step(data.e[k], data.d[k]));
+    // Every other sample rejected by the loop, or missing.
+    static_cast<void>(gated.step(data.e[k], data.d[k], k % 2 == 0));
+    if (k % 2 == 0) {
+      static_cast<void>(skipped.step(data.e[k], data.d[k]));
+    } else {
+      skipped.skip();
+    }
+  }
+  EXPECT_GT(plain.estimator().updates(), 100U);
+  EXPECT_EQ(gated.estimator().updates(), 0U);
+  EXPECT_EQ(skipped.estimator().updates(), 0U);
+}
+
 TEST(DriftEstimator, StaysWithinItsBounds) {
   DriftEstimatorConfig c{};
   c.max_relative_change = 0.2;
