@@ -27,14 +27,33 @@ struct DriverEntry {
 namespace {
 
 void read_simulated(io::YamlMap& driver, const daemon::DaemonConfig& config,
-                    plant::PlantConfig& plant_config, std::vector<std::string>& problems) {
+                    DriverSections& sections, std::vector<std::string>& problems) {
+  plant::PlantConfig& plant_config = sections.plant;
   const std::filesystem::path path =
       config.source.parent_path() / driver.required<std::string>("plant");
+  TemperatureRamp& ramp = sections.temperature;
+  ramp = {};
+  if (auto t = driver.optional_map("temperature")) {
+    t->read("start_degc", ramp.start_degc);
+    ramp.end_degc = ramp.start_degc;
+    t->read("end_degc", ramp.end_degc);
+    t->read("ramp_s", ramp.ramp_s);
+    t->finish();
+    if (!(std::isfinite(ramp.start_degc) && std::isfinite(ramp.end_degc) &&
+          std::isfinite(ramp.ramp_s) && ramp.ramp_s >= 0.0)) {
+      problems.push_back(driver.locate(
+          "driver.temperature: start_degc, end_degc must be finite and ramp_s finite and >= 0"));
+    }
+  }
   try {
     plant_config = plant::load_plant_file(path).plant;
   } catch (const std::exception& e) {
     problems.push_back(driver.locate(std::string("driver.plant: ") + e.what()));
     return;
+  }
+  if (ramp != TemperatureRamp{} && !plant_config.temperature.enabled) {
+    problems.push_back(driver.locate("driver.temperature: the plant (" + path.string() +
+                                     ") has no temperature model (plant.temperature.enabled)"));
   }
   const double ratio = plant_config.sample_rate_hz / config.loop.rate_hz;
   if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio || ratio < 1.0) {
@@ -69,11 +88,9 @@ std::unique_ptr<runtime::Driver> create_modbus(const DriverSections& sections) {
 const std::array<DriverEntry, 5> kDrivers{{
     {"simulated",
      [](io::YamlMap& driver, const daemon::DaemonConfig& config, DriverSections& sections,
-        std::vector<std::string>& problems) {
-       read_simulated(driver, config, sections.plant, problems);
-     },
+        std::vector<std::string>& problems) { read_simulated(driver, config, sections, problems); },
      [](const DriverSections& sections) -> std::unique_ptr<runtime::Driver> {
-       return std::make_unique<SimulatedTransducer>(sections.plant);
+       return std::make_unique<SimulatedTransducer>(sections.plant, sections.temperature);
      }},
     {"can",
      [](io::YamlMap& driver, const daemon::DaemonConfig& config, DriverSections& sections,

@@ -8,7 +8,8 @@
 
 namespace selfsense::drivers {
 
-SimulatedTransducer::SimulatedTransducer(plant::PlantConfig config) : config_(std::move(config)) {}
+SimulatedTransducer::SimulatedTransducer(plant::PlantConfig config, TemperatureRamp temperature)
+    : config_(std::move(config)), ramp_(temperature), temperature_degc_(temperature.start_degc) {}
 
 bool SimulatedTransducer::configure(const runtime::DriverSetup& setup, std::string* why) {
   const double ratio = config_.sample_rate_hz * setup.sample_time;
@@ -50,7 +51,10 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
   const bool pulse = cycles_ < pulse_end_cycle_.load(std::memory_order_acquire);
   const double force = force_n_.load(std::memory_order_relaxed) +
                        (pulse ? pulse_n_.load(std::memory_order_relaxed) : 0.0);
-  const plant::StepInput input{command_, force, 25.0};
+  const double t = static_cast<double>(cycles_) * sample_time_;
+  const double share = ramp_.ramp_s > 0.0 ? std::min(1.0, t / ramp_.ramp_s) : 1.0;
+  temperature_degc_ = ramp_.start_degc + (ramp_.end_degc - ramp_.start_degc) * share;
+  const plant::StepInput input{command_, force, temperature_degc_};
   plant::StepOutput o{};
   // The plant may run several steps per loop cycle; a fault flag raised in any of them is the
   // device's (like the sticky bits of a status register), not only one in the step read last.

@@ -85,9 +85,18 @@ AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& mode
   if (!(range_margin >= 0.0)) {
     throw std::invalid_argument{"adaptation: range_margin must be >= 0"};
   }
+  if (config.load_stiffness_ratio > 0.0) {
+    if (!kernel_.actuator() || !(kernel_.actuator()->coupling() > 0.0)) {
+      throw std::invalid_argument{
+          "adaptation.load_stiffness_ratio: needs a model with an actuator side and a compliance"};
+    }
+    const double r = config.load_stiffness_ratio;
+    mount_gain_ = -(r / kernel_.actuator()->coupling()) / (1.0 + r);
+  }
 }
 
-AdaptedReconstruction::Estimate AdaptedReconstruction::step(double field, double sensed) noexcept {
+AdaptedReconstruction::Estimate AdaptedReconstruction::step(double field, double sensed,
+                                                            bool learn) noexcept {
   const models::SampleStatus status = gate_.check(field, sensed);
   if (status != models::SampleStatus::kOk) {
     counts_.add(status);
@@ -100,7 +109,7 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::step(double field, double
     out.status = status;
     return out;
   }
-  const Estimate out = kernel_step(field, sensed, true);
+  const Estimate out = kernel_step(field, sensed, learn);
   counts_.add(out.status);
   held_ = {field, sensed, true};
   last_ = out;
@@ -112,15 +121,22 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field,
   models::SideOperator& s = *kernel_.sensor();
   const double fixed_s = s.offset() + s.quadratic() * field * field;  // not scaled by the drift
   const SideSplit::Parts ps = sensor_split_.split(s, field, s.step_unloaded(field) - fixed_s);
-  estimator_.step(field, sensed - fixed_s, ps.linear, ps.loop, accepted);
+  SideSplit::Parts pa{};
+  double fixed_a = 0.0;
+  if (kernel_.actuator()) {
+    models::SideOperator& a = *kernel_.actuator();
+    fixed_a = a.offset() + a.quadratic() * field * field;
+    pa = actuator_split_->split(a, field, a.step_unloaded(field) - fixed_a);
+  }
+  const double mount_stress = mount_gain_ * (fixed_a + pa.linear + pa.loop);  // header comment
+  estimator_.step(field, sensed - fixed_s - s.coupling() * mount_stress, ps.linear, ps.loop,
+                  accepted);
   const Drift dr = estimator_.drift();
   const double unloaded = fixed_s + (1.0 + dr.permittivity) * ps.linear + (1.0 + dr.loop) * ps.loop;
   Estimate out{(sensed - unloaded) / ((1.0 + dr.coupling) * s.coupling()), kNaN,
                models::SampleStatus::kOk};
   if (kernel_.actuator()) {
-    models::SideOperator& a = *kernel_.actuator();
-    const double fixed_a = a.offset() + a.quadratic() * field * field;
-    const SideSplit::Parts pa = actuator_split_->split(a, field, a.step_unloaded(field) - fixed_a);
+    const models::SideOperator& a = *kernel_.actuator();
     out.strain = fixed_a + (1.0 + dr.coupling) * pa.linear + (1.0 + dr.loop) * pa.loop +
                  (1.0 + dr.compliance) * a.coupling() * out.stress;
   }

@@ -28,7 +28,8 @@ bool DriftEstimatorConfig::is_valid(const std::string& prefix, std::string* why)
                 {"permittivity_per_k", permittivity_per_k},
                 {"loop_per_k", loop_per_k},
                 {"coupling_per_k", coupling_per_k},
-                {"compliance_per_k", compliance_per_k}};
+                {"compliance_per_k", compliance_per_k},
+                {"load_stiffness_ratio", load_stiffness_ratio}};
   for (const auto& f : finite) {
     if (!std::isfinite(f.value)) return fail(why, prefix + f.key + ": must be finite");
   }
@@ -42,6 +43,9 @@ bool DriftEstimatorConfig::is_valid(const std::string& prefix, std::string* why)
     return fail(why, prefix + "max_relative_change: must be in (0, 1)");
   }
   if (permittivity_per_k == 0.0) return fail(why, prefix + "permittivity_per_k: must not be 0");
+  if (!(load_stiffness_ratio >= 0.0)) {
+    return fail(why, prefix + "load_stiffness_ratio: must be >= 0");
+  }
   return true;
 }
 

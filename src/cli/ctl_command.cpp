@@ -198,6 +198,17 @@ void add_ctl_command(CLI::App& app) {
   state->add_option("action", *state_action, "save")->required()->check(CLI::IsMember({"save"}));
   state->callback([options] { send_request(*options, daemon::to_json(daemon::StateRequest{})); });
 
+  auto adapt_action = std::make_shared<std::string>();
+  CLI::App* adapt = ctl->add_subcommand(
+      "adapt", "Freeze or resume the online drift estimate, or show it (docs/adaptation.md)");
+  adapt->fallthrough();
+  adapt->add_option("action", *adapt_action, "freeze | resume | show")
+      ->required()
+      ->check(CLI::IsMember({"freeze", "resume", "show"}));
+  adapt->callback([options, adapt_action] {
+    send_request(*options, nlohmann::json{{"request", "adapt"}, {"action", *adapt_action}});
+  });
+
   auto force = std::make_shared<double>(0.0);
   auto duration = std::make_shared<double>(5e-4);
   CLI::App* impulse = ctl->add_subcommand(

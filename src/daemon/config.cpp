@@ -5,6 +5,7 @@
 #include <span>
 #include <string_view>
 
+#include "selfsense/adaptation/adapted_reconstruction.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 
 namespace selfsense::daemon {
@@ -187,6 +188,25 @@ void read_socket(YamlMap s, SocketSection& out, const std::filesystem::path& bas
   s.finish();
 }
 
+void read_adaptation(YamlMap a, AdaptationSection& out) {
+  adaptation::DriftEstimatorConfig& e = out.estimator;
+  a.read("enabled", out.enabled);
+  a.read("frozen", e.frozen);
+  a.read("learn_loop", e.learn_loop);
+  a.read("min_field_step_v_per_m", e.min_field_step_v_per_m);
+  a.read("max_interval_s", e.max_interval_s);
+  a.read("memory_updates", e.memory_updates);
+  a.read("initial_variance", e.initial_variance);
+  a.read("max_relative_change", e.max_relative_change);
+  a.read("reference_degc", e.reference_degc);
+  a.read("permittivity_per_k", e.permittivity_per_k);
+  a.read("loop_per_k", e.loop_per_k);
+  a.read("coupling_per_k", e.coupling_per_k);
+  a.read("compliance_per_k", e.compliance_per_k);
+  a.read("load_stiffness_ratio", e.load_stiffness_ratio);
+  a.finish();
+}
+
 // Value and cross-field rules, every problem collected.
 void validate(const DaemonConfig& c, Problems& p) {
   const double fs = c.loop.rate_hz;
@@ -252,6 +272,8 @@ void validate(const DaemonConfig& c, Problems& p) {
   p.check(c.socket.max_clients >= 1 && c.socket.max_clients <= 1024, "socket.max_clients",
           "must be within [1, 1024]");
   p.check(c.telemetry.period_s > 0.0, "telemetry.period_s", "must be > 0");
+  // Checked whether enabled or not: a section that is switched on later must already be valid.
+  if (!c.adaptation.estimator.is_valid("adaptation.", &why)) p.add(why);
 }
 
 // The model must reconstruct from what the drivers measure (E and D, field drive).
@@ -268,6 +290,13 @@ void check_model(const DaemonConfig& c, Problems& p) {
     if (!sensor) {
       p.add("model: " + c.model.string() +
             " cannot reconstruct stress (no sensor side with a stress coupling)");
+    } else if (c.adaptation.enabled && c.adaptation.estimator.is_valid("", nullptr)) {
+      try {  // the model must be one the adaptation runs (field drive, no corrections)
+        static_cast<void>(
+            adaptation::AdaptedReconstruction(m, c.adaptation.estimator, c.sample_time()));
+      } catch (const std::exception& e) {
+        p.add("adaptation.enabled: " + c.model.string() + ": " + e.what());
+      }
     }
   } catch (const std::exception& e) {
     p.add(std::string("model: ") + e.what());
@@ -331,6 +360,7 @@ ConfigResult load_config(const std::filesystem::path& path, DriverSectionReader*
       m->read("period_s", c.telemetry.period_s);
       m->finish();
     }
+    if (auto m = root.optional_map("adaptation")) read_adaptation(*m, c.adaptation);
     Problems problems(root, result.problems);
     validate(c, problems);
     if (!c.model.empty()) check_model(c, problems);

@@ -30,6 +30,17 @@ std::string hex(std::uint64_t value) {
   return {text.data()};
 }
 
+// The online drift estimate (status `adaptation`, `ctl adapt show`).
+nlohmann::json adaptation_json(const runtime::AdaptationStatus& a) {
+  if (!a.enabled) return {{"enabled", false}};
+  return {{"enabled", true},
+          {"frozen", a.frozen},
+          {"permittivity_change", a.permittivity},
+          {"loop_change", a.loop},
+          {"temperature_degc", a.temperature_degc},
+          {"updates", a.updates}};
+}
+
 }  // namespace
 
 RequestLimits ControlHandler::limits() {
@@ -179,6 +190,7 @@ nlohmann::json ControlHandler::status() {
         {"S", number_or_null(s.last.s_ref)},
         {"T", number_or_null(s.last.t_ref)}}},
       {"wave_running", s.wave_running},
+      {"adaptation", adaptation_json(s.adaptation)},
       {"model",
        {{"path", running.model.string()},
         {"hash", hex(running.model_hash)},
@@ -238,6 +250,19 @@ nlohmann::json ControlHandler::handle(const Request& request, const PeerCredenti
     const Daemon::StateSaved saved = daemon_->dump_model_state();
     if (!saved.error.empty()) return error_reply("state: " + saved.error);
     return ok_reply({{"path", saved.path.string()}});
+  }
+  if (const auto* a = std::get_if<AdaptRequest>(&request)) {
+    if (!daemon_->config().adaptation.enabled) {
+      return error_reply("adapt: adaptation is off (adaptation.enabled in " +
+                         daemon_->config().source.string() + "; a restart takes it)");
+    }
+    if (a->action == AdaptRequest::Action::kShow) {
+      return ok_reply({{"adaptation", adaptation_json(daemon_->status().adaptation)}});
+    }
+    const bool freeze = a->action == AdaptRequest::Action::kFreeze;
+    nlohmann::json reply = send({0, CommandKind::kAdapt, freeze ? 1.0 : 0.0}, "adapt");
+    if (reply.value("ok", false)) reply["frozen"] = freeze;
+    return reply;
   }
   if (const auto* i = std::get_if<ImpulseRequest>(&request)) {
     runtime::ForceInput* input = daemon_->force_input();

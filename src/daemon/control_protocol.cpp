@@ -16,9 +16,10 @@ namespace {
 using nlohmann::json;
 using Shape = control::WaveGenerator::Shape;
 
-constexpr std::array<std::string_view, 11> kRequestNames = {
+constexpr std::array<std::string_view, 12> kRequestNames = {
     "status", "arm",    "disarm", "reset",   "setpoint", "mode",
-    "wave",   "record", "reload", "impulse", "state"};
+    "wave",   "record", "reload", "impulse", "state",    "adapt"};
+constexpr std::array<std::string_view, 3> kAdaptActions = {"freeze", "resume", "show"};
 constexpr std::array<std::string_view, RequestLimits::kModes> kModeNames = {"position", "force",
                                                                             "open-loop", "damping"};
 // Echoed user strings are cut so an error reply stays short whatever was sent.
@@ -216,6 +217,15 @@ StateRequest parse_state(const json& object) {
   reject(m.path("action") + ": " + echo(action) + " is not an action (save)");
 }
 
+AdaptRequest parse_adapt(const json& object) {
+  const Members m(object, "adapt", {"action"}, "adapt");
+  const std::string action = m.text("action");
+  for (std::size_t i = 0; i < kAdaptActions.size(); ++i) {
+    if (action == kAdaptActions[i]) return AdaptRequest{static_cast<AdaptRequest::Action>(i)};
+  }
+  reject(m.path("action") + ": " + echo(action) + " is not an action (freeze, resume, show)");
+}
+
 ImpulseRequest parse_impulse(const json& object, const RequestLimits& limits) {
   const Members m(object, "impulse", {"force_n", "duration_s"}, "impulse");
   const double force = m.number("force_n");
@@ -387,6 +397,7 @@ Request parse_object(const json& object, const RequestLimits& limits) {
   if (kind == "record") return parse_record(object);
   if (kind == "impulse") return parse_impulse(object, limits);
   if (kind == "state") return parse_state(object);
+  if (kind == "adapt") return parse_adapt(object);
   reject("request: " + echo(kind) + " is not a request (" + joined(kRequestNames) + ")");
 }
 
@@ -520,6 +531,9 @@ nlohmann::json to_json(const Request& request) {
     out["action"] = record->action == RecordRequest::Action::kStart ? "start" : "stop";
   }
   if (std::holds_alternative<StateRequest>(request)) out["action"] = "save";
+  if (const auto* adapt = std::get_if<AdaptRequest>(&request)) {
+    out["action"] = std::string(kAdaptActions[static_cast<std::size_t>(adapt->action)]);
+  }
   if (const auto* impulse = std::get_if<ImpulseRequest>(&request)) {
     out["force_n"] = impulse->force_n;
     out["duration_s"] = impulse->duration_s;

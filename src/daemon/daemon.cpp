@@ -12,6 +12,7 @@
 #include <thread>
 #include <utility>
 
+#include "selfsense/adaptation/adapted_reconstruction.hpp"
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/daemon/model_state_file.hpp"
 #include "selfsense/daemon/prometheus.hpp"
@@ -74,9 +75,23 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
   const models::TransducerModel model = models::load_model(config_.model);
   model_text_ = models::model_to_string(model);
   model_hash_ = models::parameter_hash(model);
-  auto reconstruction = std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts});
-  state_buffer_ = reconstruction->make_saved_state();
-  restore_model_state(*reconstruction);
+  std::unique_ptr<models::Reconstruction> reconstruction;
+  std::unique_ptr<adaptation::AdaptedReconstruction> adapted;
+  if (config_.adaptation.enabled) {
+    adapted = std::make_unique<adaptation::AdaptedReconstruction>(model,
+                                                                  config_.adaptation.estimator, ts);
+    state_buffer_ = adapted->make_saved_state();
+    state_of_ = StateOf::kAdapted;
+    restore_model_state(state_of_, [&adapted](const models::SavedState& saved) {
+      return adapted->restore_state(saved);
+    });
+  } else {
+    reconstruction = std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts});
+    state_buffer_ = reconstruction->make_saved_state();
+    restore_model_state(state_of_, [&reconstruction](const models::SavedState& saved) {
+      return reconstruction->restore_state(saved);
+    });
+  }
   const runtime::Controller controller(config_.control, model.actuator, ts);
   std::string why;
   if (!driver_->configure({ts}, &why)) throw std::runtime_error("driver: " + why);
@@ -88,13 +103,18 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
   recorder_ =
       std::make_unique<Recorder>(recorder_config(config_, driver_->has_references()), fault_name);
   sink_ = std::make_unique<Sink>(*recorder_);
-  loop_ = std::make_unique<runtime::Loop>(config_.loop_config(), *driver_,
-                                          std::move(reconstruction), controller, sink_.get());
+  loop_ = adapted
+              ? std::make_unique<runtime::Loop>(config_.loop_config(), *driver_, std::move(adapted),
+                                                controller, sink_.get())
+              : std::make_unique<runtime::Loop>(config_.loop_config(), *driver_,
+                                                std::move(reconstruction), controller, sink_.get());
   runner_ = std::make_unique<runtime::LoopRunner>(
       *loop_, clock_, std::llround(ts * 1e9), rt_options(config_.loop), driver_->cycle_trigger());
 }
 
-void Daemon::restore_model_state(models::Reconstruction& model) {
+void Daemon::restore_model_state(
+    StateOf running,
+    const std::function<models::RestoreResult(const models::SavedState&)>& restore) {
   const std::filesystem::path& path = config_.model_state;
   if (path.empty()) return;
   std::error_code ec;
@@ -103,8 +123,18 @@ void Daemon::restore_model_state(models::Reconstruction& model) {
     return;
   }
   try {
-    const models::SavedState saved = read_model_state(path);
-    switch (model.restore_state(saved)) {
+    StateOf wrote = StateOf::kPlain;
+    const models::SavedState saved = read_model_state(path, &wrote);
+    if (wrote != running) {
+      // The sizes differ too, but the reason is the configuration, not the file.
+      state_at_start_ = "not restored: " + path.string() + ": written by the " +
+                        std::string(to_string(wrote)) + " reconstruction, the daemon runs the " +
+                        std::string(to_string(running)) + " one (adaptation.enabled)";
+      static_cast<void>(
+          std::fprintf(stderr, "selfsensed: model state: %s\n", state_at_start_.c_str()));
+      return;
+    }
+    switch (restore(saved)) {
       case models::RestoreResult::kOk:
         state_at_start_ = "restored";  // the file is removed once the loop runs (run())
         break;
@@ -133,7 +163,7 @@ Daemon::StateSaved Daemon::save_model_state(const std::filesystem::path& path) {
     return out;
   }
   try {
-    write_model_state(path, state_buffer_);
+    write_model_state(path, state_buffer_, state_of_);
   } catch (const std::exception& e) {
     out.error = e.what();
     return out;
@@ -245,7 +275,11 @@ ReloadResult Daemon::reload() {
     const models::TransducerModel model = models::load_model(n.model);
     model_text = models::model_to_string(model);
     model_hash = models::parameter_hash(model);
-    if (model_text != model_text_) {
+    if (model_text != model_text_ && config_.adaptation.enabled) {
+      problems.push_back("model: " + n.model.string() +
+                         ": a new model is not taken while adaptation is enabled (the learned "
+                         "drift is relative to the running model); restart the service");
+    } else if (model_text != model_text_) {
       const double ts = config_.sample_time();
       reconstruction = std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts});
       feedforward = std::make_unique<runtime::Feedforward>(
@@ -338,6 +372,8 @@ void Daemon::write_telemetry() {
   const runtime::StatusSnapshot s = loop_->status();
   try {
     std::vector<MetricFamily> families = loop_metrics(s);
+    for (MetricFamily& f : adaptation_metrics(s.adaptation))
+      families.push_back(std::move(f));
     for (MetricFamily& f : driver_metrics(driver_->name(), s.driver))
       families.push_back(std::move(f));
     for (MetricFamily& f : recorder_metrics(recorder_->counters()))

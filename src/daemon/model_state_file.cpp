@@ -14,7 +14,12 @@
 
 namespace selfsense::daemon {
 
-void write_model_state(const std::filesystem::path& path, const models::SavedState& state) {
+std::string_view to_string(StateOf of) noexcept {
+  return of == StateOf::kAdapted ? "adapted" : "plain";
+}
+
+void write_model_state(const std::filesystem::path& path, const models::SavedState& state,
+                       StateOf of) {
   for (const double v : state.values) {
     if (!std::isfinite(v))
       throw std::runtime_error(path.string() + ": a state value is not finite");
@@ -23,7 +28,9 @@ void write_model_state(const std::filesystem::path& path, const models::SavedSta
   text += models::to_string(state.identity.structure);
   char hash[32];
   static_cast<void>(std::snprintf(hash, sizeof hash, "%016" PRIx64, state.identity.parameter_hash));
-  text += std::string("\nparameter_hash: \"") + hash + "\"\nvalues: [";
+  text += std::string("\nparameter_hash: \"") + hash + "\"\nreconstruction: ";
+  text += to_string(of);
+  text += "\nvalues: [";
   char number[32];
   for (std::size_t i = 0; i < state.values.size(); ++i) {
     static_cast<void>(std::snprintf(number, sizeof number, "%.17g", state.values[i]));
@@ -44,7 +51,7 @@ void write_model_state(const std::filesystem::path& path, const models::SavedSta
     throw std::runtime_error(path.string() + ": cannot replace the model state: " + ec.message());
 }
 
-models::SavedState read_model_state(const std::filesystem::path& path) {
+models::SavedState read_model_state(const std::filesystem::path& path, StateOf* of) {
   io::YamlMap root = io::YamlMap::load_file(path);
   if (root.required<int>("selfsense_model_state") != 1) {
     root.fail("selfsense_model_state", "unknown format (this version reads 1)");
@@ -64,6 +71,12 @@ models::SavedState read_model_state(const std::filesystem::path& path) {
     root.fail("parameter_hash", "expected 16 hexadecimal digits");
   }
   state.identity.parameter_hash = std::stoull(hash, nullptr, 16);
+  std::string kind = "plain";
+  root.read("reconstruction", kind);
+  if (kind != "plain" && kind != "adapted") {
+    root.fail("reconstruction", "'" + kind + "' is not one of plain, adapted");
+  }
+  if (of != nullptr) *of = kind == "adapted" ? StateOf::kAdapted : StateOf::kPlain;
   if (!root.has("values")) root.fail("values", "missing");
   root.read_sequence("values", state.values);
   for (std::size_t i = 0; i < state.values.size(); ++i) {

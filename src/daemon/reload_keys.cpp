@@ -26,6 +26,8 @@ using P = control::Pid::Params;
 using Sh = control::SetpointShaper::Params;
 using Dm = control::DampingController::Params;
 using S = SafetySection;
+using A = AdaptationSection;
+using E = adaptation::DriftEstimatorConfig;
 constexpr Reload kLive = Reload::kLive;
 constexpr Reload kRefused = Reload::kRefused;
 
@@ -116,6 +118,34 @@ const std::array kTable{
     ReloadKey{"telemetry.prometheus_file", kRefused,
               differs<&C::telemetry, &TelemetrySection::prometheus_file>},
     ReloadKey{"telemetry.period_s", kRefused, differs<&C::telemetry, &TelemetrySection::period_s>},
+    // The learned drift is relative to the running model and read with these coefficients;
+    // `ctl adapt freeze|resume` freezes and resumes at run time.
+    ReloadKey{"adaptation.enabled", kRefused, differs<&C::adaptation, &A::enabled>},
+    ReloadKey{"adaptation.frozen", kRefused, differs<&C::adaptation, &A::estimator, &E::frozen>},
+    ReloadKey{"adaptation.learn_loop", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::learn_loop>},
+    ReloadKey{"adaptation.min_field_step_v_per_m", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::min_field_step_v_per_m>},
+    ReloadKey{"adaptation.max_interval_s", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::max_interval_s>},
+    ReloadKey{"adaptation.memory_updates", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::memory_updates>},
+    ReloadKey{"adaptation.initial_variance", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::initial_variance>},
+    ReloadKey{"adaptation.max_relative_change", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::max_relative_change>},
+    ReloadKey{"adaptation.reference_degc", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::reference_degc>},
+    ReloadKey{"adaptation.permittivity_per_k", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::permittivity_per_k>},
+    ReloadKey{"adaptation.loop_per_k", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::loop_per_k>},
+    ReloadKey{"adaptation.coupling_per_k", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::coupling_per_k>},
+    ReloadKey{"adaptation.compliance_per_k", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::compliance_per_k>},
+    ReloadKey{"adaptation.load_stiffness_ratio", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::load_stiffness_ratio>},
 };
 
 // `key_path` is `row` or lies under it ("row.x", "row[i]...").

@@ -75,6 +75,26 @@ std::vector<MetricFamily> loop_metrics(const runtime::StatusSnapshot& s) {
   return f;
 }
 
+std::vector<MetricFamily> adaptation_metrics(const runtime::AdaptationStatus& a) {
+  using T = MetricType;
+  std::vector<MetricFamily> f;
+  if (!a.enabled) return f;
+  f.push_back(one("selfsense_adaptation_permittivity_change",
+                  "Estimated relative change of the permittivity against the model.", T::kGauge,
+                  a.permittivity));
+  f.push_back(one("selfsense_adaptation_loop_change",
+                  "Estimated relative change of the hysteresis loop against the model.", T::kGauge,
+                  a.loop));
+  f.push_back(one("selfsense_adaptation_temperature_celsius",
+                  "Equivalent temperature of the permittivity change.", T::kGauge,
+                  a.temperature_degc));
+  f.push_back(one("selfsense_adaptation_frozen", "1 while learning is frozen.", T::kGauge,
+                  a.frozen ? 1.0 : 0.0));
+  f.push_back(one("selfsense_adaptation_updates_total", "Updates of the drift estimate.",
+                  T::kCounter, static_cast<double>(a.updates)));
+  return f;
+}
+
 std::vector<MetricFamily> driver_metrics(std::string_view driver,
                                          const runtime::DriverCounters& c) {
   std::vector<MetricFamily> f;

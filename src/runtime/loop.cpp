@@ -62,9 +62,25 @@ bool LoopConfig::is_valid(std::string* why) const {
 
 Loop::Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Reconstruction> model,
            const Controller& controller, SampleSink* sink)
+    : Loop(config, driver, std::move(model), nullptr, controller, sink) {
+  if (!model_) throw std::invalid_argument("loop: needs a model");
+}
+
+Loop::Loop(const LoopConfig& config, Driver& driver,
+           std::unique_ptr<adaptation::AdaptedReconstruction> model, const Controller& controller,
+           SampleSink* sink)
+    : Loop(config, driver, nullptr, std::move(model), controller, sink) {
+  if (!adapted_) throw std::invalid_argument("loop: needs a model");
+  publish_adaptation();
+}
+
+Loop::Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Reconstruction> model,
+           std::unique_ptr<adaptation::AdaptedReconstruction> adapted, const Controller& controller,
+           SampleSink* sink)
     : config_(config),
       driver_(&driver),
       model_(std::move(model)),
+      adapted_(std::move(adapted)),
       controller_(controller),
       sink_(sink),
       supervisor_(config.overrun),
@@ -73,7 +89,6 @@ Loop::Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Rec
       retired_(kRetiredCapacity) {
   std::string why;
   if (!config.is_valid(&why)) throw std::invalid_argument(why);
-  if (!model_) throw std::invalid_argument("loop: needs a model");
   command_ = safe_command();
   status_.mode = controller_.mode();
 }
@@ -108,10 +123,16 @@ void Loop::handle(const LoopCommand& c) noexcept {
     case CommandKind::kDisarm:
       ramp_left_ = 0;
       return answer(c, supervisor_.disarm() ? CommandResult::kDone : CommandResult::kRefusedState);
-    case CommandKind::kSaveState:
-      return answer(c, c.state != nullptr && model_->save_state(*c.state)
-                           ? CommandResult::kDone
-                           : CommandResult::kInvalid);
+    case CommandKind::kSaveState: {
+      const bool saved = c.state != nullptr &&
+                         (adapted_ ? adapted_->save_state(*c.state) : model_->save_state(*c.state));
+      return answer(c, saved ? CommandResult::kDone : CommandResult::kInvalid);
+    }
+    case CommandKind::kAdapt:
+      if (!adapted_) return answer(c, CommandResult::kInvalid);
+      adapted_->set_frozen(c.value != 0.0);
+      publish_adaptation();
+      return answer(c, CommandResult::kDone);
     case CommandKind::kRampDown: {
       if (!supervisor_.armed()) return answer(c, CommandResult::kRefusedState);
       if (!(c.value >= 0.0) || !std::isfinite(c.value)) return answer(c, CommandResult::kInvalid);
@@ -159,10 +180,11 @@ void Loop::handle(const LoopCommand& c) noexcept {
     case CommandKind::kSwapModel:
       // Not under a closed loop: the new model's estimate may differ from the old one's, and
       // a step of the estimate would be a step of the actuator. What is refused is handed back.
-      if (c.model == nullptr || supervisor_.state() == LoopState::kArmed) {
+      // Nor under adaptation: the learned drift is relative to the running model.
+      if (c.model == nullptr || adapted_ || supervisor_.state() == LoopState::kArmed) {
         static_cast<void>(retired_.try_push({nullptr, c.model, c.feedforward}));
-        return answer(c,
-                      c.model == nullptr ? CommandResult::kInvalid : CommandResult::kRefusedState);
+        return answer(c, c.model == nullptr || adapted_ ? CommandResult::kInvalid
+                                                        : CommandResult::kRefusedState);
       }
       c.model->adopt_state(*model_);
       if (c.feedforward != nullptr) controller_.swap_feedforward(*c.feedforward);
@@ -171,6 +193,24 @@ void Loop::handle(const LoopCommand& c) noexcept {
       ++status_.model_swaps;
       return answer(c, CommandResult::kDone);
   }
+}
+
+models::Reconstruction::Estimate Loop::estimate(double e, double d) noexcept {
+  if (!adapted_) return model_->step(e, d);
+  // Learning only from a sample nothing else in this cycle found wrong.
+  const adaptation::AdaptedReconstruction::Estimate a = adapted_->step(e, d, active_causes_ == 0);
+  return {a.stress, a.strain, a.status};
+}
+
+void Loop::publish_adaptation() noexcept {
+  if (!adapted_) return;
+  const adaptation::Drift drift = adapted_->drift();
+  status_.adaptation = {true,
+                        adapted_->estimator().frozen(),
+                        drift.permittivity,
+                        drift.loop,
+                        drift.temperature_degc,
+                        static_cast<std::uint64_t>(adapted_->estimator().updates())};
 }
 
 double Loop::setpoint() noexcept {
@@ -215,7 +255,7 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
   sample.t_ref = in.t_ref;
   sample.driver_status = in.device_status;
   if (read == DriverStatus::kOk) {
-    const models::Reconstruction::Estimate est = model_->step(in.e, in.d);
+    const models::Reconstruction::Estimate est = estimate(in.e, in.d);
     sample.estimate_status = static_cast<std::uint8_t>(est.status);
     ++status_.estimate_status[static_cast<std::size_t>(est.status)];
     if (est.status != models::SampleStatus::kOk) {
@@ -224,13 +264,18 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
       const bool strain_ok = !std::isfinite(est.strain) ||
                              (est.strain >= config_.strain_min && est.strain <= config_.strain_max);
       const bool stress_ok = est.stress >= config_.stress_min && est.stress <= config_.stress_max;
-      if (!strain_ok || !stress_ok) cause(Fault::kEstimateOutOfRange);
+      if (!strain_ok || !stress_ok) {
+        cause(Fault::kEstimateOutOfRange);
+        if (adapted_) adapted_->skip();
+      }
       s_hat_ = std::isfinite(est.strain) ? est.strain : 0.0;
       t_hat_ = est.stress;
       estimate_valid_ = true;
     }
     sample.t_hat = est.stress;
     sample.s_hat = est.strain;
+  } else if (adapted_) {
+    adapted_->skip();
   }
   supervisor_.note_cycle(overrun, cycle_, missed);
   if (config_.watchdog_s > 0.0 && supervisor_.armed() && !wave_running_ &&
@@ -274,6 +319,7 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
     for (std::size_t i = 0; i < kFaultCount; ++i)
       status_.fault_records[i] = supervisor_.record(static_cast<Fault>(i));
     status_.driver = driver_->counters();
+    publish_adaptation();
     published_.publish(status_);
   }
 }

@@ -158,6 +158,29 @@ TEST(DriftEstimator, LearnsNothingOnHoldsRejectedSamplesOrWhenFrozen) {
   EXPECT_EQ(est.drift().permittivity, before.permittivity);
 }
 
+// The loop's own rejections (runtime/loop.hpp): a sample estimated with learn = false and a
+// sample skipped (a driver fault) each leave the estimator without an anchor, so no increment
+// spans them; the same field steps without them update every time.
+TEST(AdaptedReconstruction, LearnsNothingAcrossSamplesTheLoopRejects) {
+  const Drifted data = drifted(0.08, -0.08, 0.04, 4000, 7);
+  AdaptedReconstruction plain(data.model, DriftEstimatorConfig{});
+  AdaptedReconstruction gated(data.model, DriftEstimatorConfig{});
+  AdaptedReconstruction skipped(data.model, DriftEstimatorConfig{});
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    static_cast<void>(plain.step(data.e[k], data.d[k]));
+    // Every other sample rejected by the loop, or missing.
+    static_cast<void>(gated.step(data.e[k], data.d[k], k % 2 == 0));
+    if (k % 2 == 0) {
+      static_cast<void>(skipped.step(data.e[k], data.d[k]));
+    } else {
+      skipped.skip();
+    }
+  }
+  EXPECT_GT(plain.estimator().updates(), 100U);
+  EXPECT_EQ(gated.estimator().updates(), 0U);
+  EXPECT_EQ(skipped.estimator().updates(), 0U);
+}
+
 TEST(DriftEstimator, StaysWithinItsBounds) {
   DriftEstimatorConfig c{};
   c.max_relative_change = 0.2;
@@ -228,6 +251,53 @@ TEST(AdaptedReconstruction, RejectsSpikesAndLearnsNothingFromThem) {
   EXPECT_EQ(rec.estimator().updates(), updates);
   EXPECT_EQ(rec.step(std::nan(""), 0.0).status, models::SampleStatus::kInputNotFinite);
   EXPECT_EQ(rec.counts()[models::SampleStatus::kInputOutOfRange], 1U);
+}
+
+// On a load spring (the daemon's bench: r = k_load / k_stack = 0.21) the stress follows the
+// field: T = -(r / s) / (1 + r) S_free, s the compliance, S_free the drifted actuator's free
+// strain. Taken as independent of the field, that stress is learned as permittivity (the
+// estimate is pulled far from +8 %); with the mount's ratio it is found as on a free stack.
+TEST(AdaptedReconstruction, FindsTheRiseOnALoadSpringWithTheMountsRatio) {
+  constexpr double kRatio = 0.21;
+  Drifted data = drifted(0.08, -0.08, 0.04, 200000, 5);
+  const models::SideModel& sensor = *data.model.sensor;
+  const models::SideModel& actuator = *data.model.actuator;
+  models::SideOperator sensor_truth(sensor);
+  models::SideOperator actuator_truth(actuator);
+  const SideSplit sensor_split(sensor_truth);
+  const SideSplit actuator_split(actuator_truth);
+  const double gain = -(kRatio / actuator_truth.coupling()) / (1.0 + kRatio);
+  double lo = 1e300;
+  double hi = -1e300;
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    const double e = data.e[k];
+    const SideSplit::Parts ps =
+        sensor_split.split(sensor_truth, e, sensor_truth.step_unloaded(e) - sensor.offset);
+    const SideSplit::Parts pa =
+        actuator_split.split(actuator_truth, e, actuator_truth.step_unloaded(e) - actuator.offset);
+    const double t = gain * (actuator.offset + 1.04 * pa.linear + 0.92 * pa.loop);
+    data.t[k] = t;
+    data.d[k] =
+        sensor.offset + 0.92 * ps.loop + 1.08 * ps.linear + 1.04 * sensor_truth.coupling() * t;
+    lo = std::min(lo, data.d[k]);
+    hi = std::max(hi, data.d[k]);
+  }
+  data.model.sensed_range = models::InputRange{lo, hi};
+  const Found free = run(data, DriftEstimatorConfig{});
+  EXPECT_GT(std::abs(free.drift.permittivity - 0.08), 0.02);  // the spring, learned as drift
+  DriftEstimatorConfig mounted{};
+  mounted.load_stiffness_ratio = kRatio;
+  // Found to 0.0756 (43.9 degC): the mount's stress is predicted from the model's free strain,
+  // not the drifted one (+4 % coupling, -8 % loop), a second-order error; asserted at 1.3x.
+  const Found f = run(data, mounted);
+  EXPECT_NEAR(f.drift.permittivity, 0.08, 0.006);
+  EXPECT_NEAR(f.drift.temperature_degc, 45.0, 1.5);
+  EXPECT_LT(f.err_adapted, 0.2 * free.err_adapted);
+  DriftEstimatorConfig bad{};
+  bad.load_stiffness_ratio = -0.1;
+  std::string why;
+  EXPECT_FALSE(bad.is_valid("adaptation.", &why));
+  EXPECT_EQ(why, "adaptation.load_stiffness_ratio: must be >= 0");
 }
 
 TEST(AdaptedReconstruction, RefusesWhatItCannotAdapt) {

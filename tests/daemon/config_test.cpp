@@ -114,5 +114,55 @@ TEST(DaemonConfig, ModelAndDriverProblemsAreNamed) {
   EXPECT_TRUE(has(version, "selfsensed: format version 2 is not supported"));
 }
 
+// adaptation: plain keys with DriftEstimatorConfig's defaults, strict, validated with its
+// is_valid() under the section's name, at the key's line.
+TEST(DaemonConfig, TheAdaptationSectionIsReadStrictlyAndValidated) {
+  drivers::Registry registry;
+  const ConfigResult shipped = load_config(kConfigDir / "sim.yaml", &registry);
+  ASSERT_TRUE(shipped.ok()) << shipped.problems.front();
+  EXPECT_FALSE(shipped.config.adaptation.enabled);
+  adaptation::DriftEstimatorConfig bench;  // the defaults, and the bench's load spring
+  bench.load_stiffness_ratio = 0.21;
+  EXPECT_EQ(shipped.config.adaptation.estimator, bench);
+
+  const ConfigResult on = load_sim("adapt", {{"  enabled: false                # true: the loop",
+                                              "  enabled: true                 # true: the loop"},
+                                             {"memory_updates: 500", "memory_updates: 800"},
+                                             {"  frozen: false ", "  frozen: true  "}});
+  ASSERT_TRUE(on.ok()) << on.problems.front();
+  EXPECT_TRUE(on.config.adaptation.enabled);
+  EXPECT_TRUE(on.config.adaptation.estimator.frozen);
+  EXPECT_EQ(on.config.adaptation.estimator.memory_updates, 800.0);
+
+  const ConfigResult bad = load_sim("adapt-bad", {{"memory_updates: 500", "memory_updates: 1"}});
+  EXPECT_TRUE(has(bad, ".test-adapt-bad.yaml:")) << bad.problems.front();
+  EXPECT_TRUE(has(bad, "adaptation.memory_updates: must be > 1")) << bad.problems.front();
+  const ConfigResult zero =
+      load_sim("adapt-zero", {{"permittivity_per_k: 4.0e-3", "permittivity_per_k: 0.0"}});
+  EXPECT_TRUE(has(zero, "adaptation.permittivity_per_k: must not be 0")) << zero.problems.front();
+  const ConfigResult mount =
+      load_sim("adapt-mount", {{"load_stiffness_ratio: 0.21", "load_stiffness_ratio: -0.2"}});
+  EXPECT_TRUE(has(mount, "adaptation.load_stiffness_ratio: must be >= 0"))
+      << mount.problems.front();
+  const ConfigResult unknown = load_sim("adapt-unknown", {{"  compliance_per_k: 5.0e-4",
+                                                           "  compliance_per_k: 5.0e-4\n"
+                                                           "  forget: 3"}});
+  EXPECT_TRUE(has(unknown, "adaptation.forget")) << unknown.problems.front();
+}
+
+// The simulated stack's temperature ramp needs the plant's temperature model.
+TEST(DaemonConfig, TheSimulatedTemperatureRampIsReadAndChecked) {
+  const ConfigResult r =
+      load_sim("ramp", {{"plant: plant/daemon.yaml",
+                         "plant: plant/daemon.yaml\n  temperature: {start_degc: 25, end_degc: 45, "
+                         "ramp_s: 30}"}});
+  EXPECT_TRUE(has(r, "driver.temperature: the plant")) << (r.ok() ? "" : r.problems.front());
+  const ConfigResult neg = load_sim(
+      "ramp-neg", {{"plant: plant/daemon.yaml",
+                    "plant: plant/temperature.yaml\n  temperature: {end_degc: 45, ramp_s: -1}"}});
+  EXPECT_TRUE(has(neg, "driver.temperature: start_degc, end_degc must be finite and ramp_s"))
+      << (neg.ok() ? "" : neg.problems.front());
+}
+
 }  // namespace
 }  // namespace selfsense::daemon

@@ -128,6 +128,19 @@ TEST(ControlProtocol, State) {
   EXPECT_EQ(to_json(StateRequest{}).dump(), R"({"action":"save","request":"state"})");
 }
 
+TEST(ControlProtocol, Adapt) {
+  using A = AdaptRequest::Action;
+  EXPECT_EQ(accepted(R"({"request":"adapt","action":"freeze"})"),
+            Request(AdaptRequest{A::kFreeze}));
+  EXPECT_EQ(accepted(R"({"request":"adapt","action":"resume"})"),
+            Request(AdaptRequest{A::kResume}));
+  EXPECT_EQ(accepted(R"({"request":"adapt","action":"show"})"), Request(AdaptRequest{A::kShow}));
+  EXPECT_EQ(rejected(R"({"request":"adapt","action":"thaw"})"),
+            R"(adapt.action: "thaw" is not an action (freeze, resume, show))");
+  EXPECT_EQ(rejected(R"({"request":"adapt"})"), "adapt.action: missing");
+  EXPECT_EQ(to_json(AdaptRequest{A::kResume}).dump(), R"({"action":"resume","request":"adapt"})");
+}
+
 TEST(ControlProtocol, PeriodicWaves) {
   const Request sine = accepted(
       R"({"request":"wave","shape":"sine","amplitude":4e-4,"offset":6e-4,"frequency_hz":1,"phase":0.25,"repeat":3})");
@@ -280,11 +293,11 @@ TEST(ControlProtocol, WaveStopAndShapes) {
 TEST(ControlProtocol, RequestMemberErrors) {
   EXPECT_EQ(rejected(R"({"value":1})"),
             "request: missing (one of status, arm, disarm, reset, setpoint, mode, wave, record, "
-            "reload, impulse, state)");
+            "reload, impulse, state, adapt)");
   EXPECT_EQ(rejected(R"({"request":7})"), "request: expected a string, got number");
   EXPECT_EQ(
       rejected(R"({"request":"launch"})"),
-      R"(request: "launch" is not a request (status, arm, disarm, reset, setpoint, mode, wave, record, reload, impulse, state))");
+      R"(request: "launch" is not a request (status, arm, disarm, reset, setpoint, mode, wave, record, reload, impulse, state, adapt))");
   // A long name is cut in the reply.
   const std::string error = rejected(R"({"request":")" + std::string(10'000, 'x') + R"("})");
   EXPECT_LT(error.size(), 200U);

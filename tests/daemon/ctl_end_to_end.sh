@@ -50,6 +50,9 @@ expect 1 '{"error":"mode.name: \"fast\" is not a mode (position, force, open-loo
 expect 0 '{"ok":true,"request":{"name":"position","request":"mode"}}' mode position
 expect 0 '{"ok":true,"request":{"action":"start","request":"record"}}' record start
 expect 0 '{"ok":true,"request":{"action":"stop","request":"record"}}' record stop
+for action in freeze resume show; do
+  expect 0 "{\"ok\":true,\"request\":{\"action\":\"$action\",\"request\":\"adapt\"}}" adapt "$action"
+done
 
 expect 0 '{"ok":true,"request":{"amplitude":0.0004,"frequency_hz":1.0,"offset":0.0006,"phase":0.0,"repeat":3,"request":"wave","shape":"sine"}}' \
   wave sine --amplitude 4e-4 --offset 6e-4 --frequency 1 --repeat 3
@@ -83,6 +86,7 @@ echo "ok: ctl status --socket ... --pretty"
 
 # Usage errors are refused before anything is sent.
 if "$bin" ctl --socket "$sock" record pause >/dev/null 2>&1; then fail "record pause was accepted"; fi
+if "$bin" ctl --socket "$sock" adapt thaw >/dev/null 2>&1; then fail "adapt thaw was accepted"; fi
 if "$bin" ctl --socket "$sock" setpoint >/dev/null 2>&1; then fail "setpoint without a value was accepted"; fi
 echo "ok: usage errors"
 

@@ -8,9 +8,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 
 #include "daemon/recording_support.hpp"
+#include "selfsense/adaptation/adapted_reconstruction.hpp"
 #include "selfsense/io/yaml_map.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 #include "selfsense/models/runtime_model.hpp"
@@ -61,6 +63,56 @@ TEST(ModelStateFile, TheMemoryRoundTripsExactlyIntoItsOwnModelOnly) {
   EXPECT_EQ(another.restore_state(read), models::RestoreResult::kWrongModel);
 }
 
+// The adapted reconstruction's state (kernel memory and learned drift) round-trips with its
+// identity and the `reconstruction: adapted` key; a plain one reads as plain (also a file from
+// before the key), and the adapted reconstruction refuses the plain state of the same model.
+TEST(ModelStateFile, TheAdaptedStateSaysSoAndRoundTrips) {
+  const testing::ScratchDir dir("model-state-adapted");
+  const std::filesystem::path source = SELFSENSE_SOURCE_DIR;
+  const models::TransducerModel model =
+      models::load_model(source / "config" / "models" / "sim.yaml");
+  adaptation::AdaptedReconstruction running(model, {}, 1e-4);
+  models::Simulation plant(model, models::RuntimeOptions{1e-4});
+  for (int k = 0; k < 20000; ++k) {  // the sensed D 1 % above the model's: a drift to learn
+    const double e = 1.0e6 + 0.9e6 * std::sin(2.0 * std::numbers::pi * 5.0 * 1e-4 * k);
+    static_cast<void>(running.step(e, 1.01 * plant.step(e, 0.0).sensed));
+  }
+  ASSERT_GT(running.estimator().updates(), 10U);
+  models::SavedState saved = running.make_saved_state();
+  ASSERT_TRUE(running.save_state(saved));
+  const std::filesystem::path path = dir.path() / "adapted.yaml";
+  write_model_state(path, saved, StateOf::kAdapted);
+  StateOf of = StateOf::kPlain;
+  const models::SavedState read = read_model_state(path, &of);
+  EXPECT_EQ(of, StateOf::kAdapted);
+  EXPECT_EQ(read.values, saved.values);
+  adaptation::AdaptedReconstruction restored(model, {}, 1e-4);
+  ASSERT_EQ(restored.restore_state(read), models::RestoreResult::kOk);
+  EXPECT_EQ(restored.estimator().updates(), running.estimator().updates());
+  EXPECT_EQ(restored.drift().permittivity, running.drift().permittivity);
+
+  models::Reconstruction plain(model, models::RuntimeOptions{1e-4});
+  const std::filesystem::path plain_path = dir.path() / "plain.yaml";
+  write_model_state(plain_path, plain.make_saved_state());
+  const models::SavedState plain_state = read_model_state(plain_path, &of);
+  EXPECT_EQ(of, StateOf::kPlain);
+  EXPECT_EQ(restored.restore_state(plain_state), models::RestoreResult::kWrongSize);
+  EXPECT_EQ(plain.restore_state(read), models::RestoreResult::kWrongSize);
+
+  std::string text = test::read_text(plain_path);
+  text.replace(text.find("reconstruction: plain\n"), 22, "");  // a file from before the key
+  test::write_text(plain_path, text);
+  of = StateOf::kAdapted;
+  static_cast<void>(read_model_state(plain_path, &of));
+  EXPECT_EQ(of, StateOf::kPlain);
+  std::string adapted_text = test::read_text(path);
+  adapted_text.replace(adapted_text.find("adapted"), 7, "warm");
+  test::write_text(plain_path, adapted_text);
+  EXPECT_NE(error_of(plain_path).find("reconstruction: 'warm' is not one of plain, adapted"),
+            std::string::npos)
+      << error_of(plain_path);
+}
+
 TEST(ModelStateFile, ACutOrMalformedFileIsNamedByLineAndKey) {
   const testing::ScratchDir dir("model-state-bad");
   models::SavedState s;
@@ -85,7 +137,7 @@ TEST(ModelStateFile, ACutOrMalformedFileIsNamedByLineAndKey) {
             std::string::npos)
       << error_of(bad);
   testing::write_text(bad, edited(", 0.5,", ", x,"));
-  EXPECT_NE(error_of(bad).find(":4: values[1]"), std::string::npos) << error_of(bad);
+  EXPECT_NE(error_of(bad).find(":5: values[1]"), std::string::npos) << error_of(bad);
   testing::write_text(bad, edited("complete", "spare: 1\ncomplete"));
   EXPECT_NE(error_of(bad).find("spare"), std::string::npos) << error_of(bad);
 }

@@ -26,15 +26,15 @@ declare -A allowed=(
   [io]="io base"
   [model_io]="model_io models operators io base"
   [plant_io]="plant_io plant io base"
-  [runtime]="runtime models operators control base"
-  [daemon]="daemon runtime models operators control io model_io base"
+  [runtime]="runtime adaptation models operators control base"
+  [daemon]="daemon runtime adaptation models operators control io model_io base"
   [drivers/sim]="drivers/sim runtime models operators control plant base"
   [drivers/can]="drivers/can runtime models operators control io base"
   [drivers/modbus]="drivers/modbus runtime models operators control io base"
   [drivers/spi]="drivers/spi runtime models operators control io base"
-  [drivers/registry]="drivers/registry drivers/sim drivers/can drivers/modbus drivers/spi daemon runtime models operators control io model_io plant plant_io base"
+  [drivers/registry]="drivers/registry drivers/sim drivers/can drivers/modbus drivers/spi daemon runtime adaptation models operators control io model_io plant plant_io base"
   [cli]="*"
-  [selfsensed]="selfsensed daemon drivers/registry runtime models operators control io model_io base"
+  [selfsensed]="selfsensed daemon drivers/registry runtime adaptation models operators control io model_io base"
 )
 folders_of() {
   case "$1" in

@@ -1,8 +1,11 @@
 // Real-time path proof for the whole loop: 1e5 cycles with the simulated transducer, in every
 // control mode, with a wave, faults, resets and model swaps, make no heap allocation, with a
-// hysteresis-creep model and with the daemon's shipped Preisach-class model.
+// hysteresis-creep model and with the daemon's shipped Preisach-class model; and the same with
+// the adapted reconstruction (adaptation/adapted_reconstruction.hpp), learning, frozen and
+// resumed through the command ring, a swap refused.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <memory>
 
@@ -30,7 +33,7 @@ class CountingSink final : public SampleSink {
   LoopSample last_{};
 };
 
-void every_mode_without_allocating(const models::TransducerModel& model) {
+void every_mode_without_allocating(const models::TransducerModel& model, bool adapt = false) {
   constexpr double kTs = 1e-4;
   plant::PlantConfig pc;
   pc.sample_rate_hz = 1e4;
@@ -54,9 +57,16 @@ void every_mode_without_allocating(const models::TransducerModel& model) {
   lc.strain_min = -1.0;
   lc.strain_max = 1.0;
   CountingSink sink;
-  Loop loop(lc, driver,
-            std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{kTs}),
-            Controller(cc, model.actuator, kTs), &sink);
+  std::unique_ptr<Loop> loop_owner =
+      adapt ? std::make_unique<Loop>(lc, driver,
+                                     std::make_unique<adaptation::AdaptedReconstruction>(
+                                         model, adaptation::DriftEstimatorConfig{}, kTs),
+                                     Controller(cc, model.actuator, kTs), &sink)
+            : std::make_unique<Loop>(
+                  lc, driver,
+                  std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{kTs}),
+                  Controller(cc, model.actuator, kTs), &sink);
+  Loop& loop = *loop_owner;
   // Prepared outside the loop, as the control thread does.
   auto next_model = std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{kTs});
   auto next_feedforward = std::make_unique<Feedforward>(make_feedforward(cc, model.actuator, kTs));
@@ -75,7 +85,13 @@ void every_mode_without_allocating(const models::TransducerModel& model) {
   tuned.filter_count = 2;
   tuned.position = {1.2e8, 1e11, 0.0};
   tuned.command_max = 1.8e6;
-  models::SavedState state = next_model->make_saved_state();  // a state dump's buffer
+  // A state dump's buffer, sized for the running reconstruction.
+  models::SavedState state =
+      adapt ? adaptation::AdaptedReconstruction(model, adaptation::DriftEstimatorConfig{}, kTs)
+                  .make_saved_state()
+            : next_model->make_saved_state();
+  int adapts_done = 0;
+  std::uint64_t frozen_updates = 0;
   int tunes_done = 0;
   int states_saved = 0;
   std::uint64_t state_id = 0;
@@ -111,6 +127,7 @@ void every_mode_without_allocating(const models::TransducerModel& model) {
         c = {id, CommandKind::kSwapModel, 0.0, mode, nullptr, next_model.release()};
         c.feedforward = next_feedforward.release();
       }
+      if (k == 30000 || k == 42000) c = {id, CommandKind::kAdapt, k == 30000 ? 1.0 : 0.0};
       if (k == 60000) {
         ASSERT_TRUE(driver.inject(plant::FaultKind::nan_sample, plant::Channel::d, 1, 3));
       }
@@ -122,6 +139,13 @@ void every_mode_without_allocating(const models::TransducerModel& model) {
       while (loop.take_answer(a)) {
         if (a.id == tune_id && a.result == CommandResult::kDone) ++tunes_done;
         if (a.id == state_id && a.result == CommandResult::kDone) ++states_saved;
+        if (a.result == CommandResult::kDone && k >= 30000 && k <= 30002) ++adapts_done;
+      }
+      if (k == 30100) frozen_updates = loop.local_status().adaptation.updates;
+      // Frozen from 30000 to 42000: not one update.
+      if (adapt && k == 41999) {
+        ASSERT_EQ(loop.local_status().adaptation.updates, frozen_updates);
+        ASSERT_TRUE(loop.local_status().adaptation.frozen);
       }
     }
     EXPECT_EQ(counter.count(), 0U);
@@ -137,7 +161,18 @@ void every_mode_without_allocating(const models::TransducerModel& model) {
   }
   EXPECT_EQ(sink.count_, 100000U);
   EXPECT_GT(loop.local_status().commands, 10U);
-  EXPECT_EQ(loop.local_status().model_swaps, 1U);
+  // Under adaptation a swap is refused (the learned drift is the running model's) and the
+  // model handed back.
+  EXPECT_EQ(loop.local_status().model_swaps, adapt ? 0U : 1U);
+  const AdaptationStatus& a = loop.local_status().adaptation;
+  EXPECT_EQ(a.enabled, adapt);
+  if (adapt) {
+    EXPECT_EQ(adapts_done, 1);
+    EXPECT_FALSE(a.frozen);
+    EXPECT_GT(a.updates, frozen_updates);
+    EXPECT_GT(frozen_updates, 50U);
+    EXPECT_TRUE(std::isfinite(a.temperature_degc));
+  }
 }
 
 TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
@@ -152,6 +187,16 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithTheShippedPreisachModel) {
   ASSERT_TRUE(model.actuator.has_value());
   ASSERT_FALSE(model.actuator->op.hinges.weights.empty());
   every_mode_without_allocating(model);
+}
+
+TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithAdaptation) {
+  every_mode_without_allocating(test::typical_transducer(1e-3), true);
+}
+
+TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithAdaptationAndTheShippedPreisachModel) {
+  every_mode_without_allocating(
+      models::load_model(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config/models/sim.yaml"),
+      true);
 }
 
 }  // namespace

@@ -13,6 +13,16 @@
 // coupling d cannot be told from the stress by E and D, so it follows the equivalent temperature
 // with its coefficient per K, and so does the actuator's linear part (d E).
 //
+// The mount: on a load spring the stress follows the field (more field, more strain, more
+// load), so d' delta T is not noise but moves with delta E and would be learned as permittivity
+// (measured on the daemon's bench, r = 0.21: epsilon -7 % while the stack warmed by 20 K). With
+// the load's stiffness over the stack's, r = load_stiffness_ratio, the quasi-static stress of
+// the mount is predicted from the model's free strain S_free = y0_a + q_a E^2 + L_a + H_a:
+//   delta T = -kappa delta S,  delta S = delta S_free + s_a delta T,  kappa = r / s_a
+//   =>  T_mount = -(r / s_a) / (1 + r) S_free                                              [Pa]
+// and the estimator learns from D - d_s T_mount (constants cancel in its increments). r = 0:
+// the stress is taken as independent of the field (docs/adaptation.md).
+//
 // A sample whose inputs are not finite or outside the identification range (widened by
 // range_margin of its span) is rejected as models::Reconstruction rejects it: the operators
 // advance with the last accepted inputs, the estimator learns nothing and drops its anchor.
@@ -74,7 +84,13 @@ class AdaptedReconstruction final {
   AdaptedReconstruction(const models::TransducerModel& model, const DriftEstimatorConfig& config,
                         double sample_time = 0.0, double range_margin = 0.5);
 
-  Estimate step(double field, double sensed) noexcept;
+  Estimate step(double field, double sensed) noexcept { return step(field, sensed, true); }
+  // learn false: the sample is estimated but the estimator learns nothing from it and drops
+  // its anchor (the loop's own rejection: a fault cause in the same cycle).
+  Estimate step(double field, double sensed, bool learn) noexcept;
+  // A sample that never arrived (a driver fault): the operators do not advance, the estimator
+  // drops its anchor, so no increment spans the gap.
+  void skip() noexcept { estimator_.drop_anchor(); }
 
   [[nodiscard]] Drift drift() const noexcept { return estimator_.drift(); }
   [[nodiscard]] const DriftEstimator& estimator() const noexcept { return estimator_; }
@@ -112,6 +128,7 @@ class AdaptedReconstruction final {
   Estimate last_{};
   models::StatusCounts counts_{};
   models::ModelIdentity identity_{};
+  double mount_gain_{0.0};  // -(r / s_a) / (1 + r) [Pa per unit free strain]
 };
 
 }  // namespace selfsense::adaptation

@@ -63,11 +63,15 @@ struct DriftEstimatorConfig {
   double loop_per_k{-4.0e-3};         // the hysteresis loop [1/K]
   double coupling_per_k{2.0e-3};      // d: the sensor coupling and the actuator's linear part
   double compliance_per_k{5.0e-4};    // the actuator's stress coupling s^E [1/K]
+  // The mount (adapted_reconstruction.hpp): the load's stiffness over the stack's,
+  // r = k_load / k_stack [1]; 0: a free actuator, or a load that does not follow the field.
+  double load_stiffness_ratio{0.0};
 
   // Every value finite; steps, intervals, memory > 1, variance, bound positive;
-  // permittivity_per_k non-zero. *why names the key under `prefix` ("adaptation.memory_updates:
-  // must be > 1").
+  // permittivity_per_k non-zero; load_stiffness_ratio >= 0. *why names the key under `prefix`
+  // ("adaptation.memory_updates: must be > 1").
   [[nodiscard]] bool is_valid(const std::string& prefix, std::string* why) const;
+  friend bool operator==(const DriftEstimatorConfig&, const DriftEstimatorConfig&) = default;
 };
 
 // The drift as estimated: relative changes against the model, and what they mean.
@@ -96,6 +100,8 @@ class DriftEstimator final {
   [[nodiscard]] std::size_t updates() const noexcept { return updates_; }
   void set_frozen(bool frozen) noexcept { config_.frozen = frozen; }
   [[nodiscard]] bool frozen() const noexcept { return config_.frozen; }
+  // The next update needs a new anchor (a sample that was not seen: a driver fault).
+  void drop_anchor() noexcept { anchored_ = false; }
   // Sets the drift from a measured temperature instead of learning it (a temperature sensor):
   // epsilon = permittivity_per_k dT, lambda = loop_per_k dT.
   void set_temperature(double degc) noexcept;

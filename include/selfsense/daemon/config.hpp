@@ -34,6 +34,12 @@
 //              record_at_start}
 //   socket: {path, group, max_clients}
 //   telemetry: {prometheus_file, period_s}
+//   adaptation:                         # online drift estimate (docs/adaptation.md)
+//     enabled: false                    # true: the loop runs adaptation::AdaptedReconstruction
+//     frozen: false                     # start with learning frozen (ctl adapt resume)
+//     learn_loop, min_field_step_v_per_m, max_interval_s, memory_updates, initial_variance,
+//     max_relative_change, reference_degc, permittivity_per_k, loop_per_k, coupling_per_k,
+//     compliance_per_k, load_stiffness_ratio   # adaptation::DriftEstimatorConfig's keys
 #pragma once
 
 #include <cstdint>
@@ -42,6 +48,7 @@
 #include <string>
 #include <vector>
 
+#include "selfsense/adaptation/drift_estimator.hpp"
 #include "selfsense/control/filter_design.hpp"
 #include "selfsense/io/yaml_map.hpp"
 #include "selfsense/runtime/controller.hpp"
@@ -112,6 +119,13 @@ struct TelemetrySection {
   friend bool operator==(const TelemetrySection&, const TelemetrySection&) = default;
 };
 
+// The online adaptation of the reconstruction (adaptation/adapted_reconstruction.hpp).
+struct AdaptationSection {
+  bool enabled{false};
+  adaptation::DriftEstimatorConfig estimator{};  // `frozen` is the estimator's
+  friend bool operator==(const AdaptationSection&, const AdaptationSection&) = default;
+};
+
 struct DaemonConfig {
   std::filesystem::path source{};  // the file it was read from
   LoopSection loop{};
@@ -125,6 +139,7 @@ struct DaemonConfig {
   RecorderSection recorder{};
   SocketSection socket{};
   TelemetrySection telemetry{};
+  AdaptationSection adaptation{};
 
   [[nodiscard]] double sample_time() const noexcept { return 1.0 / loop.rate_hz; }
   // The loop's configuration (sample time, safety) from these sections.

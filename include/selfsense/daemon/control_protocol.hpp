@@ -13,6 +13,8 @@
 //   {"request": "wave", "shape": "stop"}
 //   {"request": "record", "action": "start"}          start | stop
 //   {"request": "state", "action": "save"}            a dump of the model's memory
+//   {"request": "adapt", "action": "freeze"}          freeze | resume | show: the online
+//                                                     drift estimate (docs/adaptation.md)
 //   {"request": "impulse", "force_n": 300, "duration_s": 5e-4}
 //                                                     a force pulse on the stack from the
 //                                                     bench (drivers with a force input: the
@@ -87,6 +89,14 @@ struct StateRequest {
   bool operator==(const StateRequest&) const = default;
 };
 
+// The online adaptation: freeze or resume learning (through the loop's command ring), or show
+// the estimate.
+struct AdaptRequest {
+  enum class Action : std::uint8_t { kFreeze, kResume, kShow };
+  Action action{Action::kShow};
+  bool operator==(const AdaptRequest&) const = default;
+};
+
 // A rectangular force pulse on the stack through the driver's runtime::ForceInput.
 struct ImpulseRequest {
   double force_n{0.0};     // [N], |force_n| <= RequestLimits::max_impulse_n
@@ -96,7 +106,7 @@ struct ImpulseRequest {
 
 using Request = std::variant<StatusRequest, ArmRequest, DisarmRequest, ResetRequest,
                              SetpointRequest, ModeRequest, WaveRequest, RecordRequest,
-                             ReloadRequest, ImpulseRequest, StateRequest>;
+                             ReloadRequest, ImpulseRequest, StateRequest, AdaptRequest>;
 
 struct SetpointRange {
   double min{0.0};

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -24,6 +25,7 @@
 #include "selfsense/daemon/config.hpp"
 #include "selfsense/daemon/control_handler.hpp"
 #include "selfsense/daemon/control_server.hpp"
+#include "selfsense/daemon/model_state_file.hpp"
 #include "selfsense/daemon/recorder.hpp"
 #include "selfsense/models/model_identity.hpp"
 #include "selfsense/runtime/driver.hpp"
@@ -95,7 +97,8 @@ class Daemon final {
   // command limits (control.command_v_per_m), in one cycle (runtime::Controller::tune). Applied
   // while disarmed: a model whose content changed (the same file rewritten, or another path),
   // with the feedforward's inverse built from it; its memory is carried over
-  // (runtime_model.hpp, adopt_state). Any other changed key, a file that does not
+  // (runtime_model.hpp, adopt_state); not while adaptation is enabled (the learned drift is
+  // relative to the running model: a restart). Any other changed key, a file that does not
   // load (half-written: a YAML or model error naming file and line) or a model change while
   // armed is refused by name and the running parameters stay.
   ReloadResult reload();
@@ -120,7 +123,10 @@ class Daemon final {
  private:
   class Sink;
   void free_retired();
-  void restore_model_state(models::Reconstruction& model);
+  // Restores the model_state file through `restore` when `running` wrote it.
+  void restore_model_state(
+      StateOf running,
+      const std::function<models::RestoreResult(const models::SavedState&)>& restore);
   StateSaved save_model_state(const std::filesystem::path& path);
   void notify_status();
   void write_telemetry();
@@ -144,6 +150,7 @@ class Daemon final {
   mutable std::mutex parameters_mutex_{};  // config_.model, model_hash_, the gains: reload writes
   std::mutex state_mutex_{};               // state_buffer_: the loop writes it while one waits
   models::SavedState state_buffer_{};      // sized for the running model
+  StateOf state_of_{StateOf::kPlain};      // the running reconstruction (adaptation.enabled)
   std::string state_at_start_{"off"};
 };
 

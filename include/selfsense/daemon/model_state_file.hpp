@@ -8,24 +8,38 @@
 //   selfsense_model_state: 1
 //   structure: hysteresis-creep
 //   parameter_hash: "0123456789abcdef"   # models::parameter_hash, hexadecimal
+//   reconstruction: adapted               # plain (models::Reconstruction; the default when
+//                                         # absent, older files) or adapted
+//                                         # (adaptation::AdaptedReconstruction: the kernel's
+//                                         # memory, then the learned drift); the daemon takes a
+//                                         # state only into the reconstruction that wrote it
 //   values: [v0, v1, ...]                 # %.17g: the doubles round-trip exactly
 //   complete: true                        # last: a file cut anywhere is refused
 //
 // Not real-time code: it allocates, does file I/O and throws.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <string_view>
 
 #include "selfsense/models/model_identity.hpp"
 
 namespace selfsense::daemon {
 
+// Which reconstruction wrote the state (the `reconstruction` key).
+enum class StateOf : std::uint8_t { kPlain, kAdapted };
+[[nodiscard]] std::string_view to_string(StateOf of) noexcept;
+
 // Writes beside `path` and renames over it, so a reader never sees half a file. Throws
 // std::runtime_error naming the path (also for a value that is not finite).
-void write_model_state(const std::filesystem::path& path, const models::SavedState& state);
+void write_model_state(const std::filesystem::path& path, const models::SavedState& state,
+                       StateOf of = StateOf::kPlain);
 
 // Throws io::YamlError ("file:line: key: ...") on a malformed or cut file, a hash that is not
 // 16 hexadecimal digits or a value that is not finite.
-[[nodiscard]] models::SavedState read_model_state(const std::filesystem::path& path);
+// *of (when not null) gets the `reconstruction` key (kPlain when absent).
+[[nodiscard]] models::SavedState read_model_state(const std::filesystem::path& path,
+                                                  StateOf* of = nullptr);
 
 }  // namespace selfsense::daemon

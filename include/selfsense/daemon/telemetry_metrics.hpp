@@ -26,6 +26,12 @@ namespace selfsense::daemon {
 // name (counters).
 [[nodiscard]] std::vector<MetricFamily> loop_metrics(const runtime::StatusSnapshot& status);
 
+// selfsense_adaptation_*: the online drift estimate (docs/adaptation.md), only when the loop
+// runs the adaptation: permittivity_change and loop_change [1], equivalent temperature_celsius,
+// frozen (0/1) gauges and updates_total.
+[[nodiscard]] std::vector<MetricFamily> adaptation_metrics(
+    const runtime::AdaptationStatus& adaptation);
+
 // selfsense_driver_*_total{driver=NAME} and selfsense_driver_events_total{driver,event}. An event
 // without a name, or whose name repeats, is left out (a driver's bug must not make the file
 // invalid).

@@ -12,6 +12,14 @@
 // with the controller left out, and disarms after the n-th: the stack is brought to the safe
 // output slower than its mount rings.
 //
+// Adaptation (the second constructor): the reconstruction is adaptation::AdaptedReconstruction,
+// which learns the permittivity drift from E and D (docs/adaptation.md). It learns nothing
+// from a sample the loop rejects: a driver status other than kOk (the sample is skipped, the
+// estimator drops its anchor), a fault cause already raised in the cycle, the model's own
+// rejection, or an estimate outside the physical range (the anchor is dropped after it). A
+// hot swap is refused (kInvalid, handed back): the learned drift is relative to the running
+// model. kAdapt freezes and resumes learning.
+//
 // Threads: cycle() runs on the real-time thread only. submit(), take_answer(), take_retired()
 // and status() are for one control thread (single producer / single consumer rings), status()
 // for any thread. cycle() is real-time safe: no allocation, lock, exception, blocking call or
@@ -22,6 +30,7 @@
 #include <memory>
 #include <string>
 
+#include "selfsense/adaptation/adapted_reconstruction.hpp"
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/models/runtime_model.hpp"
 #include "selfsense/runtime/controller.hpp"
@@ -74,6 +83,10 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
   // the first cycle; the sink may be null (nothing recorded).
   Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Reconstruction> model,
        const Controller& controller, SampleSink* sink);
+  // The adapted reconstruction instead of the plain one (header comment).
+  Loop(const LoopConfig& config, Driver& driver,
+       std::unique_ptr<adaptation::AdaptedReconstruction> model, const Controller& controller,
+       SampleSink* sink);
   Loop(const Loop&) = delete;
   Loop& operator=(const Loop&) = delete;
   Loop(Loop&&) = delete;
@@ -101,14 +114,20 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
   [[nodiscard]] const LoopConfig& config() const noexcept { return config_; }
 
  private:
+  Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Reconstruction> model,
+       std::unique_ptr<adaptation::AdaptedReconstruction> adapted, const Controller& controller,
+       SampleSink* sink);
   void handle(const LoopCommand& c) noexcept;
   void answer(const LoopCommand& c, CommandResult r) noexcept;
   [[nodiscard]] double safe_command() const noexcept;
   [[nodiscard]] double setpoint() noexcept;
+  [[nodiscard]] models::Reconstruction::Estimate estimate(double e, double d) noexcept;
+  void publish_adaptation() noexcept;
 
   LoopConfig config_;
   Driver* driver_;
   std::unique_ptr<models::Reconstruction> model_;
+  std::unique_ptr<adaptation::AdaptedReconstruction> adapted_;  // null: no adaptation
   Controller controller_;
   SampleSink* sink_;
   Supervisor supervisor_;

@@ -34,6 +34,8 @@ enum class CommandKind : std::uint8_t {
                // model takes the running one's memory); refused while armed
   kSaveState,  // state: the model's state is saved into it (sized by make_saved_state() for the
                // running model); kInvalid when it does not fit
+  kAdapt,      // value: 1 freezes the drift estimate (adaptation/drift_estimator.hpp), 0
+               // resumes learning; kInvalid when the loop runs no adaptation
   kRampDown,   // value: seconds; while armed, the command ramps linearly from its last value
                // to the safe output over that time, then the loop disarms (a stop that does not
                // knock the stack; faults still go to the safe output at once); refused unless

@@ -13,6 +13,16 @@
 
 namespace selfsense::runtime {
 
+// The online drift estimate (adaptation/drift_estimator.hpp) as the loop runs it.
+struct AdaptationStatus {
+  bool enabled{false};           // the loop runs the adapted reconstruction
+  bool frozen{false};            // learning nothing, holding the estimate
+  double permittivity{0.0};      // epsilon [1]: relative change of the permittivity
+  double loop{0.0};              // lambda [1]: relative change of the hysteresis loop
+  double temperature_degc{0.0};  // the equivalent temperature [degC]
+  std::uint64_t updates{0};      // RLS updates since the start (or the restored state's)
+};
+
 struct StatusSnapshot {
   std::int64_t cycle{0};
   LoopSample last{};
@@ -27,6 +37,7 @@ struct StatusSnapshot {
   std::uint64_t samples_dropped{0};  // the sample sink (recorder) refused them
   std::uint64_t model_swaps{0};
   bool wave_running{false};
+  AdaptationStatus adaptation{};
   // Timing, filled by the thread that runs the loop (runtime/loop_runner).
   std::int64_t overruns{0};
   std::int64_t missed_periods{0};

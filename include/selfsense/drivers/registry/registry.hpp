@@ -20,6 +20,7 @@
 #include "selfsense/daemon/config.hpp"
 #include "selfsense/drivers/can/can_config.hpp"
 #include "selfsense/drivers/modbus/modbus_config.hpp"
+#include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/drivers/spi/spi_config.hpp"
 #include "selfsense/plant/config.hpp"
 #include "selfsense/runtime/driver.hpp"
@@ -33,6 +34,7 @@ namespace selfsense::drivers {
 // What the driver sections are read into; only the chosen type's member is filled.
 struct DriverSections {
   plant::PlantConfig plant{};
+  TemperatureRamp temperature{};  // the simulated stack's (simulated_transducer.hpp)
   can::CanConfig can{};
   modbus::ModbusConfig modbus{};
   spi::SpiConfig spi{};

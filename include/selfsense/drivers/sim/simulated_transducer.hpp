@@ -18,6 +18,12 @@
 // `nan_sample_cycles`, `out_of_range_cycles`, `sensor_disconnect_cycles`); counters() reads
 // plain fields: call it from the loop's thread (the loop does, for its status snapshot).
 //
+// Temperature (the driver section's `temperature: {start_degc, end_degc, ramp_s}`): the stack's
+// temperature at loop time t = cycles * Ts since activate() [degC],
+//   theta(t) = start + (end - start) min(1, t / ramp_s)     (ramp_s 0: end from the start)
+// fed to the plant's temperature model (plant.temperature, which must be enabled): a stack that
+// warms while the daemon runs, for the online adaptation (docs/adaptation.md). Default 25 degC.
+//
 // read(), write(), inject(), set_external_force() are real-time safe.
 #pragma once
 
@@ -32,9 +38,17 @@
 
 namespace selfsense::drivers {
 
+// The stack's temperature while the daemon runs (header comment).
+struct TemperatureRamp {
+  double start_degc{25.0};
+  double end_degc{25.0};
+  double ramp_s{0.0};  // [s] >= 0
+  friend bool operator==(const TemperatureRamp&, const TemperatureRamp&) = default;
+};
+
 class SimulatedTransducer final : public runtime::Driver, public runtime::ForceInput {
  public:
-  explicit SimulatedTransducer(plant::PlantConfig config);
+  explicit SimulatedTransducer(plant::PlantConfig config, TemperatureRamp temperature = {});
 
   [[nodiscard]] std::string_view name() const noexcept override { return "simulated"; }
   bool configure(const runtime::DriverSetup& setup, std::string* why) override;
@@ -59,9 +73,13 @@ class SimulatedTransducer final : public runtime::Driver, public runtime::ForceI
   [[nodiscard]] const plant::Plant& plant() const noexcept { return *plant_; }
   [[nodiscard]] double command() const noexcept { return command_; }
   [[nodiscard]] int substeps() const noexcept { return substeps_; }
+  // The stack's temperature in the cycle read last [degC].
+  [[nodiscard]] double temperature_degc() const noexcept { return temperature_degc_; }
 
  private:
   plant::PlantConfig config_;
+  TemperatureRamp ramp_;
+  double temperature_degc_{25.0};
   std::unique_ptr<plant::Plant> plant_{};
   int substeps_{1};
   double sample_time_{0.0};
