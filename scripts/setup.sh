@@ -328,7 +328,9 @@ case "$mode" in
     done
     ls -l build/packages/
     if [ ${#cross_failed[@]} -ne 0 ]; then
-      echo "setup: no packages for ${cross_failed[*]}: their libraries could not be installed" >&2
+      echo "setup: no packages for ${cross_failed[*]}: their libraries could not be installed (apt" \
+        "above; a Multi-Arch: same library must have the build machine's version, which a mirror" \
+        "whose ${cross_failed[*]} index failed to update may not offer)" >&2
       exit 1
     fi
     ;;
