@@ -6,6 +6,13 @@
 # on the installed configurations, and a program built against the unpacked libselfsense-dev
 # with find_package(selfsense).
 #
+# A cross build's packages (cmake/toolchains/, CPACK_DEBIAN_PACKAGE_ARCHITECTURE in the build's
+# CPackConfig.cmake) are checked the same way for their architecture: the programs are ELF for
+# the target, their Depends resolve among that architecture's Debian packages (apt-get -s), and
+# the programs and the integrator's program run under the emulator in PACKAGE_EMULATOR (the
+# build's CMAKE_CROSSCOMPILING_EMULATOR, e.g. qemu-aarch64 -L /usr/aarch64-linux-gnu ...), the
+# integrator's program built with the toolchain file in PACKAGE_TOOLCHAIN.
+#
 #   check_packages.sh BUILD_DIR WORK_DIR [PACKAGES_DIR]
 set -euo pipefail
 
@@ -31,7 +38,11 @@ else
   echo "cpack: $(awk -v a="$begin" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }') s"
 fi
 
-arch=$(dpkg --print-architecture)
+arch=$(sed -n 's/^set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE "\(.*\)")$/\1/p' "$build/CPackConfig.cmake")
+[ -n "$arch" ] || arch=$(dpkg --print-architecture)
+# run PROGRAM ARGS...: on this machine, or under the cross build's emulator.
+read -r -a emulator <<<"${PACKAGE_EMULATOR:-}"
+run() { "${emulator[@]}" "$@"; }
 version=$(sed -n 's/^set(CPACK_PACKAGE_VERSION "\(.*\)")$/\1/p' "$build/CPackConfig.cmake")
 [ -n "$version" ] || { echo "FAIL: no CPACK_PACKAGE_VERSION in $build/CPackConfig.cmake"; exit 1; }
 runtime=$debs/selfsense_${version}_${arch}.deb
@@ -83,6 +94,8 @@ for part in runtime dev; do
   printf '%s: ' "$part"
   dpkg-deb -f "$deb" Package Version Architecture Depends | tr '\n' ' '
   echo
+  [ "$(dpkg-deb -f "$deb" Architecture)" = "$arch" ] ||
+    fail "$part: Architecture is $(dpkg-deb -f "$deb" Architecture), not $arch"
 done
 for script in postinst prerm postrm; do
   file=$work/runtime.control/$script
@@ -111,12 +124,38 @@ for lib in libc6 libstdc++6 libyaml-cpp0.7 libsystemd0 libmodbus5 libgpiod2; do
   grep -qE "(^|, )${lib//+/\\+}( |,|$)" <<<"$depends" || fail "selfsense: Depends has no $lib ($depends)"
 done
 grep -q 'libyaml-cpp-dev' <<<"$(dpkg-deb -f "$dev" Depends)" || fail "libselfsense-dev: Depends has no libyaml-cpp-dev"
+# The Depends resolve among this architecture's packages (multiarch: libc6:arm64, ...): apt
+# plans the installation without doing it.
+if apt-get install -s -q -o Debug::NoLocking=1 --no-install-recommends "$runtime" >"$work/apt-simulate.log" 2>&1 &&
+  grep -qE "^Inst selfsense(:$arch)? " "$work/apt-simulate.log"; then
+  echo "apt-get -s install: Depends resolve for $arch"
+else
+  tail -15 "$work/apt-simulate.log"
+  fail "apt-get -s install $(basename "$runtime"): Depends do not resolve for $arch"
+fi
 
 # The unpacked tree: the unit starts /usr/bin/selfsensed as selfsense; the installed
 # configurations name files that the package installs and pass check-config.
 root=$work/root
 dpkg-deb -x "$runtime" "$root"
 dpkg-deb -x "$dev" "$root"
+# The programs and static libraries are built for the package's architecture.
+case $arch in
+  amd64) machine='x86-64' ;;
+  arm64) machine='ARM aarch64' ;;
+  armhf) machine='ARM, EABI5' ;;
+  *) machine='' ;;
+esac
+for program in "$root/usr/bin/selfsensed" "$root/usr/bin/selfsense"; do
+  description=$(file -b "$program")
+  grep -q "^ELF .*$machine" <<<"$description" || fail "$(basename "$program") is not $arch ELF: $description"
+done
+echo "selfsensed: $(file -b "$root/usr/bin/selfsensed" | cut -d, -f1-3)"
+mkdir -p "$work/objects"
+object=$(ar t "$root/usr/lib/libselfsense_control.a" | head -1)
+(cd "$work/objects" && ar x "$root/usr/lib/libselfsense_control.a" "$object")
+file -b "$work/objects/$object" | grep -q "$machine" ||
+  fail "libselfsense_control.a is not $arch: $(file -b "$work/objects/$object")"
 unit=$root/lib/systemd/system/selfsensed.service
 grep -qx 'ExecStart=/usr/bin/selfsensed --config /etc/selfsense/selfsensed.yaml' "$unit" ||
   fail "unit: ExecStart is $(grep '^ExecStart=' "$unit")"
@@ -134,10 +173,10 @@ for config in "$root/etc/selfsense/selfsensed.yaml" "$root"/etc/selfsense/exampl
   done < <(grep -oE '/usr/share/selfsense/[^ ]+\.yaml' "$config")
   # The configuration as it reads once installed: its shared files taken from the unpacked tree.
   sed "s|/usr/share/selfsense/|$root/usr/share/selfsense/|" "$config" >"$work/check-$(basename "$config")"
-  "$root/usr/bin/selfsense" check-config "$work/check-$(basename "$config")" >"$work/check.log" 2>&1 ||
+  run "$root/usr/bin/selfsense" check-config "$work/check-$(basename "$config")" >"$work/check.log" 2>&1 ||
     fail "check-config $(basename "$config"): $(head -3 "$work/check.log")"
 done
-"$root/usr/bin/selfsensed" --help >/dev/null || fail "the packaged selfsensed --help failed"
+run "$root/usr/bin/selfsensed" --help >/dev/null || fail "the packaged selfsensed --help failed"
 
 # lintian: errors fail, the rest is listed.
 if command -v lintian >/dev/null; then
@@ -168,10 +207,12 @@ int main() {
   return pid.step(1.0, 0.0) == 2.0 ? 0 : 1;
 }
 CPP
+toolchain=()
+[ -n "${PACKAGE_TOOLCHAIN:-}" ] && toolchain=(--toolchain "$PACKAGE_TOOLCHAIN")
 if cmake -S "$work/consumer" -B "$work/consumer/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_PREFIX_PATH="$root/usr" >"$work/consumer.log" 2>&1 &&
+  "${toolchain[@]}" -DCMAKE_PREFIX_PATH="$root/usr" >"$work/consumer.log" 2>&1 &&
   cmake --build "$work/consumer/build" >>"$work/consumer.log" 2>&1 &&
-  "$work/consumer/build/consumer"; then
+  run "$work/consumer/build/consumer"; then
   echo "find_package(selfsense): a program linked selfsense::control and ran"
 else
   tail -20 "$work/consumer.log"
