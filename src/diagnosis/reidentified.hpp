@@ -86,7 +86,10 @@ struct Reidentified {
 // of the field: loop and permittivity scaled by T, coupling quadratic in T) identified there too;
 // each channel where it forecasts the second half better by forecast_explains is named, and no
 // channel may forecast worse (the structure replaces both sides). The improved model is that
-// structure identified on the whole record.
+// structure identified on the whole record. Nothing is judged where the stress does not move
+// apart from the field (a constant preload: what a fit on E and the base's outputs leaves of T is
+// below 1e-9 of its magnitude). diagnose() calls it only where its first pass named nothing or
+// nothing but stress, and takes it only where it names a channel that pass did not.
 struct StressReidentified {
   models::TransducerModel model{};  // stress-hysteresis, identified on the whole record
   Outputs outputs{};                // its D and S over the record
