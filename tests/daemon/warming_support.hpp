@@ -20,7 +20,7 @@ inline const std::filesystem::path kSource = SELFSENSE_SOURCE_DIR;
 // config/plant/daemon.yaml with the temperature model of config/plant/temperature.yaml (its
 // coefficients are the plant's defaults) as dir/plant.yaml.
 inline std::filesystem::path warming_plant(const std::filesystem::path& dir) {
-  const std::filesystem::path plant = dir / "plant.yaml";
+  std::filesystem::path plant = dir / "plant.yaml";  // returned: moved, so not const
   testing::write_text(
       plant, test::edited(testing::read_text(kSource / "config" / "plant" / "daemon.yaml"),
                           {{"  hysteresis: {enabled: true}",
