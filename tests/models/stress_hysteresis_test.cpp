@@ -55,13 +55,20 @@ struct Recorded {
   std::vector<double> e, d, s, t;
 };
 
-Recorded stressed_stack() {
-  plant::Plant p(test::stressed_stack(1000.0, 7e-6));
+// With creep_and_holds, the plant's creep on and the field held for 3 s of every 8 (the load keeps
+// moving): the polarization and the strain creep during the holds, which plays cannot follow.
+Recorded stressed_stack(bool creep_and_holds = false) {
+  plant::PlantConfig config = test::stressed_stack(1000.0, 7e-6);
+  config.creep.enabled = creep_and_holds;
+  plant::Plant p(config);
   Recorded r;
+  double e = 1e6;
   for (int k = 0; k < 60000; ++k) {
     const double time = k * 1e-3;
-    const double e = 1e6 + 0.9e6 * std::sin(2 * std::numbers::pi * 1.1 * time) *
-                               std::cos(2 * std::numbers::pi * 0.07 * time);
+    if (!creep_and_holds || std::fmod(time, 8.0) < 5.0) {
+      e = 1e6 + 0.9e6 * std::sin(2 * std::numbers::pi * 1.1 * time) *
+                    std::cos(2 * std::numbers::pi * 0.07 * time);
+    }
     const double f = 700.0 * std::sin(2 * std::numbers::pi * 0.37 * time);
     const plant::StepOutput out = p.step({e, f, 25.0});
     r.e.push_back(out.e_meas_v_per_m);
@@ -113,32 +120,8 @@ TEST(StressHysteresis, ReconstructsStressWhereTheAffineModelCannot) {
   EXPECT_EQ(vectorial.status_counts()[SampleStatus::kOk], r.e.size());
 }
 
-// The same stack with the plant's creep and the field held for 3 s of every 8 (the load keeps
-// moving): the polarization and the strain creep during the holds, which plays cannot follow.
-Recorded stressed_stack_with_holds() {
-  plant::PlantConfig config = test::stressed_stack(1000.0, 7e-6);
-  config.creep.enabled = true;
-  plant::Plant p(config);
-  Recorded r;
-  double e = 1e6;
-  for (int k = 0; k < 60000; ++k) {
-    const double time = k * 1e-3;
-    if (std::fmod(time, 8.0) < 5.0) {
-      e = 1e6 + 0.9e6 * std::sin(2 * std::numbers::pi * 1.1 * time) *
-                    std::cos(2 * std::numbers::pi * 0.07 * time);
-    }
-    const double f = 700.0 * std::sin(2 * std::numbers::pi * 0.37 * time);
-    const plant::StepOutput out = p.step({e, f, 25.0});
-    r.e.push_back(out.e_meas_v_per_m);
-    r.d.push_back(out.d_meas_c_per_m2);
-    r.s.push_back(out.s);
-    r.t.push_back(out.t_pa);
-  }
-  return r;
-}
-
 TEST(StressHysteresis, CreepLagsAmongTheColumnsFollowTheCreepDuringHolds) {
-  const Recorded r = stressed_stack_with_holds();
+  const Recorded r = stressed_stack(true);
   constexpr std::size_t kSplit = 40000;
   const auto head = [](const std::vector<double>& v) { return std::span(v).first(kSplit); };
   const auto held_out = [&r](const StressHysteresisModel& m) {
