@@ -256,7 +256,9 @@ std::optional<Reidentified> judged_as_forecast(const Judge& judge, const Channel
   }
   const std::optional<double> explains = forecast_explains(null, best, ch, judge.half(), options);
   if (!explains) return std::nullopt;
-  return identified_whole(judge, best.effect, ch, *explains);
+  std::optional<Reidentified> r = identified_whole(judge, best.effect, ch, *explains);
+  if (r) r->fit_explains = 1.0 - best.first_half_sse / null.first_half_sse;
+  return r;
 }
 
 // The model and recording allow a side to be re-identified on this channel.
@@ -286,7 +288,7 @@ std::string lags_of(const models::SideModel& side) {
   const std::vector<double>& lambda = side.op.creep.eigenvalues;
   if (lambda.empty()) return "no lags";
   const auto [lo, hi] = std::minmax_element(lambda.begin(), lambda.end());
-  return format("%zu lags of ", static_cast<double>(lambda.size())) + format("%.2g-", 1.0 / *hi) +
+  return format("%.0f lags of ", static_cast<double>(lambda.size())) + format("%.2g-", 1.0 / *hi) +
          format("%.2g s", 1.0 / *lo);
 }
 
@@ -355,20 +357,21 @@ std::optional<Reidentified> reidentified_delay(const models::TransducerModel& mo
 std::optional<Reidentified> reidentified_creep(const models::TransducerModel& model,
                                                const Signals& s, const ChannelData& ch,
                                                const std::vector<double>& current,
-                                               const Options& options) {
+                                               const Options& options,
+                                               const models::ChannelCorrection& beside) {
   if (model.structure != models::Structure::kHysteresis || !reidentifiable(model, s, ch)) {
     return std::nullopt;
   }
   constexpr models::Structure kWithCreep = models::Structure::kHysteresisCreep;
   const Judge as_is(model, s, ch);
   const Judge with_creep(s, ch, kWithCreep);
-  const Trial null = as_is.trial(models::ChannelCorrection{});
-  const Trial creep = with_creep.trial(models::ChannelCorrection{});
+  const Trial null = as_is.trial(beside);
+  const Trial creep = with_creep.trial(beside);
   const std::optional<double> explains = forecast_explains(null, creep, ch, as_is.half(), options);
   if (!explains) return std::nullopt;
-  std::optional<Reidentified> r =
-      identified_whole(with_creep, models::ChannelCorrection{}, ch, *explains);
+  std::optional<Reidentified> r = identified_whole(with_creep, beside, ch, *explains);
   if (!r) return std::nullopt;
+  r->fit_explains = 1.0 - creep.first_half_sse / null.first_half_sse;
   r->structure = kWithCreep;
   r->candidate = &candidate_using(CorrectionTerm::kCreep);
   Finding& f = r->finding;

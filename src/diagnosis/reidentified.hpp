@@ -43,6 +43,9 @@ struct Reidentified {
   const Candidate* candidate{nullptr};                // its candidate (named once per channel)
   std::vector<double> base{};                         // the re-identified side's output
   std::vector<double> output{};                       // ... through the effect
+  // The share of the null's error it removes on the half it was identified on (finding.explains:
+  // on the half it forecast); judged by a forecast only.
+  double fit_explains{0.0};
   // The structure the side was identified with, when it is not the model's (creep operators
   // added to a hysteresis model).
   std::optional<models::Structure> structure{};
@@ -71,12 +74,13 @@ struct Reidentified {
 // to new excitation. The null is the model's structure identified on the first half, the
 // candidate the same with creep operators (hysteresis-creep); the improved model carries that
 // side (the model's structure becomes hysteresis-creep, the other side unchanged, its creep
-// operators none).
-[[nodiscard]] std::optional<Reidentified> reidentified_creep(const models::TransducerModel& model,
-                                                             const Signals& s,
-                                                             const ChannelData& ch,
-                                                             const std::vector<double>& current,
-                                                             const Options& options);
+// operators none). With `beside` (a leak already re-identified on the channel), both structures
+// are identified with it undone and forecast through it, and the improved model carries it as
+// its correction.
+[[nodiscard]] std::optional<Reidentified> reidentified_creep(
+    const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
+    const std::vector<double>& current, const Options& options,
+    const models::ChannelCorrection& beside = {});
 
 // Stress dependence judged by re-identification with the stress-hysteresis structure
 // (docs/diagnose.md, "Stress dependence re-identified"): a stack whose permittivity, coupling

@@ -269,59 +269,70 @@ TEST(IndependentActuator, TheEffectChangesOnlyItsChannels) {
 
 // ---- the mechanisms, on development draws -------------------------------------------------
 
-// A stack that warmed while its base was identified on the same recording (a swing of the
-// permittivity, coupling and loop, quadratic in the change): the base bent to the drift, and
-// terms fitted after it carried nothing to new data (excess 0.94x before the re-identification).
-// With the side re-identified with the temperature's terms undone (reidentified.hpp) it is named on
-// D and the validation excess falls to 0.04x (measured). A development draw (seed base 900000),
-// not a proof draw: the proof's rates are measured on seed bases never run before
-// (docs/diagnose.md).
-TEST(IndependentMechanism, WarmingInTheBaseIsNamedWithItsTermsUndone) {
-  const Outcome o = run_draw(900000, Effect::kTemperature);
-  std::printf("%s\n", summary(o).c_str());
-  EXPECT_TRUE(o.named_right);
-  EXPECT_LE(o.extra_names, 1);
-  EXPECT_LE(o.excess_ratio, 0.3);
+// Each mechanism on the development draw that showed it (seed base 900000), not a proof draw:
+// the proof's rates are measured on seed bases never run before (docs/diagnose.md). Every case
+// must be named on its channel with at most one extra name and leave at most `excess` of the
+// validation error in excess of the clean case's; the comment says what it measures.
+struct Mechanism {
+  const char* name{""};
+  Effect effect{Effect::kNone};
+  std::uint64_t seed{0};
+  double excess{0.3};
+};
+
+// GoogleTest finds this by its name to print a parameter.
+void PrintTo(const Mechanism& m, std::ostream* os) {  // NOLINT(readability-identifier-naming)
+  *os << m.name;
 }
 
-// Strain sampled 8 samples late, with the base identified on the same recording: its fastest
-// lags bent to the lag, so a delay fitted after it lost on the slow blocks and a mode was named
-// in one stretch (validation excess 0.65x). With the side re-identified with the delay undone
-// (reidentified.hpp) the delay is named on S and the excess falls to 0.00x (measured). A
-// development draw (seed 900002), not a proof draw.
-TEST(IndependentMechanism, LateStrainInTheBaseIsNamedByAForecast) {
-  const Outcome o = run_draw(900002, Effect::kDelay);
+const Mechanism kMechanisms[] = {
+    // A stack that warmed while its base was identified on the same recording (a swing of the
+    // permittivity, coupling and loop, quadratic in the change): the base bent to the drift, and
+    // terms fitted after it carried nothing to new data (excess 0.94x before the
+    // re-identification). With the side re-identified with the temperature's terms undone
+    // (reidentified.hpp) it is named on D and the excess falls to 0.04x (measured).
+    {"WarmingInTheBaseIsNamedWithItsTermsUndone", Effect::kTemperature, 900000},
+    // Strain sampled 8 samples late, with the base identified on the same recording: its fastest
+    // lags bent to the lag, so a delay fitted after it lost on the slow blocks and a mode was
+    // named in one stretch (excess 0.65x). With the side re-identified with the delay undone the
+    // delay is named on S and the excess falls to 0.00x (measured).
+    {"LateStrainInTheBaseIsNamedByAForecast", Effect::kDelay, 900002},
+    // Strain that creeps, with a `hysteresis` base (no creep operators) identified on the same
+    // recording: its loop bent to the creep and nothing was named (`consistent`, validation S
+    // 0.761 % against 0.055 % clean). With the structure with creep operators judged as a
+    // forecast creep is named on S and the excess falls to 0.03x (measured); the improved model
+    // is a hysteresis-creep model.
+    {"CreepInALoopModelIsNamedByTheStructureWithCreep", Effect::kCreep, 900005},
+    // Stress that changes permittivity, coupling and loop, with an affine base identified on the
+    // same recording: the rounds named the coupling's change on S alone and validation D stayed
+    // at 0.294 % (clean 0.033 %). With the stress-hysteresis structure judged by two-fold
+    // cross-validation, taken because it names the stress on D too, validation D falls to
+    // 0.092 % (excess 0.22x, measured).
+    {"StressInAnAffineBaseIsNamedByCrossValidation", Effect::kStress, 900001},
+    // Strain that creeps and charge that leaks (a high-pass, tau 6230 s), with a `hysteresis`
+    // base: the rounds named creep on D, the structure with creep operators did not forecast D
+    // better, and the leak was not judged beside a creep finding (creep D and S named, validation
+    // D worse: excess 1.17x). With the leak judged wherever the creep is, it is named on D
+    // (forecast: 96 % of the null's error removed) and the rounds no longer name creep there;
+    // creep stays named on S (excess 0.52x, measured; asserted at the proof's 0.6x).
+    {"LeakBesideCreepOnTheOtherChannelIsNamed", Effect::kCreepLeakage, 900001, 0.6},
+};
+
+class IndependentMechanism : public ::testing::TestWithParam<Mechanism> {};
+
+TEST_P(IndependentMechanism, IsNamedOnItsChannelAndCarriesToNewData) {
+  const Mechanism& m = GetParam();
+  const Outcome o = run_draw(m.seed, m.effect);
   std::printf("%s\n", summary(o).c_str());
   EXPECT_TRUE(o.named_right);
   EXPECT_LE(o.extra_names, 1);
-  EXPECT_LE(o.excess_ratio, 0.3);
+  EXPECT_LE(o.excess_ratio, m.excess);
 }
 
-// Strain that creeps, with a `hysteresis` base (no creep operators) identified on the same
-// recording: its loop bent to the creep and nothing was named (`consistent`, validation S 0.761 %
-// against 0.055 % clean). With the structure with creep operators judged as a forecast
-// (reidentified.hpp) creep is named on S and the excess falls to 0.03x (measured); the improved
-// model is a hysteresis-creep model. A development draw (seed 900005), not a proof draw.
-TEST(IndependentMechanism, CreepInALoopModelIsNamedByTheStructureWithCreep) {
-  const Outcome o = run_draw(900005, Effect::kCreep);
-  std::printf("%s\n", summary(o).c_str());
-  EXPECT_TRUE(o.named_right);
-  EXPECT_LE(o.extra_names, 1);
-  EXPECT_LE(o.excess_ratio, 0.3);
-}
-
-// Stress that changes permittivity, coupling and loop, with an affine base identified on the same
-// recording: the rounds named the coupling's change on S alone and validation D stayed at 0.294 %
-// (clean 0.033 %). With the stress-hysteresis structure judged by two-fold cross-validation
-// (reidentified.hpp), taken because it names the stress on D too, validation D falls to 0.092 %
-// (excess 0.22x, measured). A development draw (seed 900001), not a proof draw.
-TEST(IndependentMechanism, StressInAnAffineBaseIsNamedByCrossValidation) {
-  const Outcome o = run_draw(900001, Effect::kStress);
-  std::printf("%s\n", summary(o).c_str());
-  EXPECT_TRUE(o.named_right);
-  EXPECT_LE(o.extra_names, 1);
-  EXPECT_LE(o.excess_ratio, 0.3);
-}
+INSTANTIATE_TEST_SUITE_P(DevelopmentDraws, IndependentMechanism, ::testing::ValuesIn(kMechanisms),
+                         [](const ::testing::TestParamInfo<Mechanism>& p) {
+                           return std::string(p.param.name);
+                         });
 
 // ---- a fixed sample of proof draws ---------------------------------------------------------
 

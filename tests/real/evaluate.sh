@@ -192,7 +192,7 @@ rug_case() {
   # measured-only); its polarization creeps during the holds, named on D from the field-drive
   # model without creep operators. The other charge-drive cases name nothing (measured-only;
   # a failed diagnose step is counted by step()).
-  local report="${name//\//-}-$structure"
+  local report="${name//\//-}-$structure" after
   # The disc set has no licence: its reports are made here and never kept.
   local SELFSENSE_REPORT_DIR=
   case "$structure:$name" in
@@ -207,9 +207,15 @@ rug_case() {
       diagnose "$report" "$work/rug.yaml" "$work/rug_fit.csv" "$work/rug_val.csv" || true
       ;;
     hysteresis:rug-disc-holds)
+      # ... and the structure with creep operators carries to the other block: validation D
+      # 25.35 % -> 6.06 % (measured), asserted at 1.3x.
       diagnose "$report" "$work/rug.yaml" "$work/rug_fit.csv" "$work/rug_val.csv" &&
         if ! grep -q '^  creep on D ' "$work/step.txt"; then
           echo "diagnose $report: creep on D not named (asserted: FAIL)"
+          failed=1
+        elif ! after=$(sed -n 's/^  validation D .* -> \([0-9.]*\) %$/\1/p' "$work/step.txt") ||
+          [ -z "$after" ] || ! at_most "$after" 7.9; then
+          echo "diagnose $report: validation D after the creep ${after:-missing} %, above 7.9 % (asserted: FAIL)"
           failed=1
         fi
       ;;
