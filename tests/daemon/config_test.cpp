@@ -207,6 +207,12 @@ TEST(DaemonConfig, TheSimulatedTemperatureRampIsReadAndChecked) {
                     "plant: plant/temperature.yaml\n  temperature: {end_degc: 45, ramp_s: -1}"}});
   EXPECT_TRUE(has(neg, "driver.temperature: start_degc, end_degc must be finite and ramp_s"))
       << (neg.ok() ? "" : neg.problems.front());
+  const ConfigResult swing = load_sim(
+      "swing",
+      {{"plant: plant/daemon.yaml",
+        "plant: plant/temperature.yaml\n  temperature: {swing_degc: 5, swing_period_s: 0}"}});
+  EXPECT_TRUE(has(swing, "driver.temperature: swing_degc must be finite and swing_period_s"))
+      << (swing.ok() ? "" : swing.problems.front());
 }
 
 }  // namespace
