@@ -38,11 +38,18 @@ void read_simulated(io::YamlMap& driver, const daemon::DaemonConfig& config,
     ramp.end_degc = ramp.start_degc;
     t->read("end_degc", ramp.end_degc);
     t->read("ramp_s", ramp.ramp_s);
+    t->read("swing_degc", ramp.swing_degc);
+    t->read("swing_period_s", ramp.swing_period_s);
     t->finish();
     if (!(std::isfinite(ramp.start_degc) && std::isfinite(ramp.end_degc) &&
           std::isfinite(ramp.ramp_s) && ramp.ramp_s >= 0.0)) {
       problems.push_back(driver.locate(
           "driver.temperature: start_degc, end_degc must be finite and ramp_s finite and >= 0"));
+    }
+    if (!(std::isfinite(ramp.swing_degc) && std::isfinite(ramp.swing_period_s) &&
+          ramp.swing_period_s > 0.0)) {
+      problems.push_back(driver.locate(
+          "driver.temperature: swing_degc must be finite and swing_period_s finite and > 0"));
     }
   }
   try {

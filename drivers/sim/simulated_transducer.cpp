@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <utility>
 
 #include "selfsense/plant/status.hpp"
@@ -53,7 +54,9 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
                        (pulse ? pulse_n_.load(std::memory_order_relaxed) : 0.0);
   const double t = static_cast<double>(cycles_) * sample_time_;
   const double share = ramp_.ramp_s > 0.0 ? std::min(1.0, t / ramp_.ramp_s) : 1.0;
-  temperature_degc_ = ramp_.start_degc + (ramp_.end_degc - ramp_.start_degc) * share;
+  temperature_degc_ =
+      ramp_.start_degc + (ramp_.end_degc - ramp_.start_degc) * share +
+      ramp_.swing_degc * std::sin(2.0 * std::numbers::pi * t / ramp_.swing_period_s);
   const plant::StepInput input{command_, force, temperature_degc_};
   plant::StepOutput o{};
   // The plant may run several steps per loop cycle; a fault flag raised in any of them is the

@@ -207,6 +207,30 @@ void read_adaptation(YamlMap a, AdaptationSection& out) {
   a.finish();
 }
 
+void read_health(YamlMap h, HealthSection& out) {
+  adaptation::HealthEstimatorConfig& e = out.estimator;
+  adaptation::HealthBands& b = out.bands;
+  h.read("enabled", out.enabled);
+  h.read("fault", b.fault);
+  h.read("max_temperature_degc", b.max_temperature_degc);
+  h.read("max_depolarisation_pct", b.max_depolarisation_pct);
+  h.read("min_leakage_resistivity_ohm_m", b.min_leakage_resistivity_ohm_m);
+  h.read("reversal_field_v_per_m", e.reversal_field_v_per_m);
+  h.read("settle_s", e.settle_s);
+  read_u32(h, "baseline_cycles", e.baseline_cycles);
+  h.read("span_tolerance", e.span_tolerance);
+  h.read("hold_field_v_per_m", e.hold_field_v_per_m);
+  h.read("hold_settle_s", e.hold_settle_s);
+  h.read("hold_window_s", e.hold_window_s);
+  h.read("min_hold_field_v_per_m", e.min_hold_field_v_per_m);
+  h.read("trend_time_s", e.trend_time_s);
+  h.read("slope_time_s", e.slope_time_s);
+  h.read("capacitance_per_k", e.capacitance_per_k);
+  h.read("dissipation_per_k", e.dissipation_per_k);
+  h.read("depolarisation_sensitivity", e.depolarisation_sensitivity);
+  h.finish();
+}
+
 // Value and cross-field rules, every problem collected.
 void validate(const DaemonConfig& c, Problems& p) {
   const double fs = c.loop.rate_hz;
@@ -274,6 +298,8 @@ void validate(const DaemonConfig& c, Problems& p) {
   p.check(c.telemetry.period_s > 0.0, "telemetry.period_s", "must be > 0");
   // Checked whether enabled or not: a section that is switched on later must already be valid.
   if (!c.adaptation.estimator.is_valid("adaptation.", &why)) p.add(why);
+  if (!c.health.estimator.is_valid("health.", &why)) p.add(why);
+  if (!c.health.bands.is_valid("health.", &why)) p.add(why);
 }
 
 // The model must reconstruct from what the drivers measure (E and D, field drive).
@@ -317,6 +343,9 @@ runtime::LoopConfig DaemonConfig::loop_config() const {
   l.overrun = safety.overrun;
   l.watchdog_s = safety.watchdog_s;
   l.status_period = loop.status_period_cycles;
+  l.health_enabled = health.enabled;
+  l.health = health.estimator;
+  l.health_bands = health.bands;
   return l;
 }
 
@@ -361,6 +390,7 @@ ConfigResult load_config(const std::filesystem::path& path, DriverSectionReader*
       m->finish();
     }
     if (auto m = root.optional_map("adaptation")) read_adaptation(*m, c.adaptation);
+    if (auto m = root.optional_map("health")) read_health(*m, c.health);
     Problems problems(root, result.problems);
     validate(c, problems);
     if (!c.model.empty()) check_model(c, problems);

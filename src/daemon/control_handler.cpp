@@ -11,6 +11,7 @@
 
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/daemon/daemon.hpp"
+#include "selfsense/daemon/health_report.hpp"
 #include "selfsense/runtime/supervisor.hpp"
 
 namespace selfsense::daemon {
@@ -191,6 +192,7 @@ nlohmann::json ControlHandler::status() {
         {"T", number_or_null(s.last.t_ref)}}},
       {"wave_running", s.wave_running},
       {"adaptation", adaptation_json(s.adaptation)},
+      {"health", health_json(s.health)},
       {"model",
        {{"path", running.model.string()},
         {"hash", hex(running.model_hash)},

@@ -14,6 +14,7 @@
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
 #include "selfsense/control/wave_generator.hpp"
+#include "selfsense/daemon/health_report.hpp"
 #include "selfsense/daemon/model_state_file.hpp"
 #include "selfsense/daemon/prometheus.hpp"
 #include "selfsense/daemon/recorder_metrics.hpp"
@@ -373,6 +374,8 @@ void Daemon::write_telemetry() {
   try {
     std::vector<MetricFamily> families = loop_metrics(s);
     for (MetricFamily& f : adaptation_metrics(s.adaptation))
+      families.push_back(std::move(f));
+    for (MetricFamily& f : health_metrics(s.health))
       families.push_back(std::move(f));
     for (MetricFamily& f : driver_metrics(driver_->name(), s.driver))
       families.push_back(std::move(f));

@@ -28,6 +28,9 @@ using Dm = control::DampingController::Params;
 using S = SafetySection;
 using A = AdaptationSection;
 using E = adaptation::DriftEstimatorConfig;
+using H = HealthSection;
+using He = adaptation::HealthEstimatorConfig;
+using Hb = adaptation::HealthBands;
 constexpr Reload kLive = Reload::kLive;
 constexpr Reload kRefused = Reload::kRefused;
 
@@ -146,6 +149,40 @@ const std::array kTable{
               differs<&C::adaptation, &A::estimator, &E::compliance_per_k>},
     ReloadKey{"adaptation.load_stiffness_ratio", kRefused,
               differs<&C::adaptation, &A::estimator, &E::load_stiffness_ratio>},
+    // The health estimate's baseline and trends are learned with these (a restart starts anew).
+    ReloadKey{"health.enabled", kRefused, differs<&C::health, &H::enabled>},
+    ReloadKey{"health.fault", kRefused, differs<&C::health, &H::bands, &Hb::fault>},
+    ReloadKey{"health.max_temperature_degc", kRefused,
+              differs<&C::health, &H::bands, &Hb::max_temperature_degc>},
+    ReloadKey{"health.max_depolarisation_pct", kRefused,
+              differs<&C::health, &H::bands, &Hb::max_depolarisation_pct>},
+    ReloadKey{"health.min_leakage_resistivity_ohm_m", kRefused,
+              differs<&C::health, &H::bands, &Hb::min_leakage_resistivity_ohm_m>},
+    ReloadKey{"health.reversal_field_v_per_m", kRefused,
+              differs<&C::health, &H::estimator, &He::reversal_field_v_per_m>},
+    ReloadKey{"health.settle_s", kRefused, differs<&C::health, &H::estimator, &He::settle_s>},
+    ReloadKey{"health.baseline_cycles", kRefused,
+              differs<&C::health, &H::estimator, &He::baseline_cycles>},
+    ReloadKey{"health.span_tolerance", kRefused,
+              differs<&C::health, &H::estimator, &He::span_tolerance>},
+    ReloadKey{"health.hold_field_v_per_m", kRefused,
+              differs<&C::health, &H::estimator, &He::hold_field_v_per_m>},
+    ReloadKey{"health.hold_settle_s", kRefused,
+              differs<&C::health, &H::estimator, &He::hold_settle_s>},
+    ReloadKey{"health.hold_window_s", kRefused,
+              differs<&C::health, &H::estimator, &He::hold_window_s>},
+    ReloadKey{"health.min_hold_field_v_per_m", kRefused,
+              differs<&C::health, &H::estimator, &He::min_hold_field_v_per_m>},
+    ReloadKey{"health.trend_time_s", kRefused,
+              differs<&C::health, &H::estimator, &He::trend_time_s>},
+    ReloadKey{"health.slope_time_s", kRefused,
+              differs<&C::health, &H::estimator, &He::slope_time_s>},
+    ReloadKey{"health.capacitance_per_k", kRefused,
+              differs<&C::health, &H::estimator, &He::capacitance_per_k>},
+    ReloadKey{"health.dissipation_per_k", kRefused,
+              differs<&C::health, &H::estimator, &He::dissipation_per_k>},
+    ReloadKey{"health.depolarisation_sensitivity", kRefused,
+              differs<&C::health, &H::estimator, &He::depolarisation_sensitivity>},
 };
 
 // `key_path` is `row` or lies under it ("row.x", "row[i]...").

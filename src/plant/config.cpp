@@ -93,6 +93,12 @@ bool PlantConfig::is_valid(std::string* why) const {
   c.finite("temperature.hysteresis_coefficient_per_k", temperature.hysteresis_coefficient_per_k);
   c.finite("temperature.compliance_coefficient_per_k", temperature.compliance_coefficient_per_k);
 
+  c.non_negative("aging.polarisation_loss_per_h", aging.polarisation_loss_per_h);
+  c.non_negative("aging.capacitance_loss_per_h", aging.capacitance_loss_per_h);
+  c.non_negative("aging.leakage_resistivity_ohm_m", aging.leakage_resistivity_ohm_m);
+  c.non_negative("aging.leakage_growth_per_h", aging.leakage_growth_per_h);
+  c.non_negative("aging.start_s", aging.start_s);
+
   c.positive("mechanics.resonance_hz", mechanics.resonance_hz);
   if (mechanics.enabled) {
     std::ostringstream constraint;

@@ -30,6 +30,24 @@ Scales temperature_scales(const TemperatureConfig& t, double temp_degc) noexcept
                 scale(t.compliance_coefficient_per_k, dt)};
 }
 
+// The aging scales at the plant's time t (AgingConfig in config.hpp).
+Scales with_aging(Scales s, const AgingConfig& a, double t_s) noexcept {
+  if (!a.enabled) return s;
+  const double hours = std::max(0.0, t_s - a.start_s) / 3600.0;
+  const double polarisation = scale(-a.polarisation_loss_per_h, hours);
+  s.d *= polarisation;
+  s.hysteresis *= polarisation;
+  s.eps *= scale(-a.capacitance_loss_per_h, hours);
+  return s;
+}
+
+// The leakage conductivity at the plant's time t [S/m]; 0 without leakage.
+double leakage_conductivity(const AgingConfig& a, double t_s) noexcept {
+  if (!a.enabled || !(a.leakage_resistivity_ohm_m > 0.0)) return 0.0;
+  return (1.0 + a.leakage_growth_per_h * std::max(0.0, t_s - a.start_s) / 3600.0) /
+         a.leakage_resistivity_ohm_m;
+}
+
 Scales with_stress(Scales s, const StressConfig& st, double stress_pa) noexcept {
   if (!st.enabled) return s;
   s.eps *= scale(st.permittivity_coefficient_per_pa, stress_pa);
@@ -181,8 +199,10 @@ StepOutput Plant::step(const StepInput& input) noexcept {
 
   // Strain and stress at the self-consistent stress, then commit creep and mechanics.
   const double length = derived_.length_m;
-  const MechanicalInput in{temperature_scales(c.temperature, input.temp_degc), e, dp,
-                           c.mechanics.load_force_n + input.force_n};
+  const double t_s = static_cast<double>(s.sample) * ts_;
+  const MechanicalInput in{
+      with_aging(temperature_scales(c.temperature, input.temp_degc), c.aging, t_s), e, dp,
+      c.mechanics.load_force_n + input.force_n};
   const double t_c = c.stress.enabled ? solve_stress(c, length, s, in) : 0.0;
   const MechanicalResponse r = respond(c, length, s, in, t_c);
   const double s_free = r.s_inst + s.creep_s.update(r.s_inst);
@@ -203,7 +223,8 @@ StepOutput Plant::step(const StepInput& input) noexcept {
 
   const double electrode_area = c.geometry.layers * c.geometry.electrode_area_m2;
   const double q = electrode_area * (d - s.d0);
-  const double q_amp = s.charge_amplifier.update(q, s.random);
+  s.q_leak_c += electrode_area * leakage_conductivity(c.aging, t_s) * e * ts_;
+  const double q_amp = s.charge_amplifier.update(q + s.q_leak_c, s.random);
 
   const double du = u - s.u_prev_v;
   if (std::abs(du) > 1e-3) {
@@ -223,7 +244,7 @@ StepOutput Plant::step(const StepInput& input) noexcept {
       Measurement{s.channel_e.out_of_range_value(), s.channel_d.out_of_range_value()}, &flags);
 
   StepOutput out{};
-  out.t_s = static_cast<double>(s.sample) * ts_;
+  out.t_s = t_s;
   out.e_meas_v_per_m = measured.e_v_per_m;
   out.d_meas_c_per_m2 = measured.d_c_per_m2;
   out.e_v_per_m = e;

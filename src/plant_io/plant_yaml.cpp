@@ -124,6 +124,16 @@ void read_plant(YamlMap p, PlantConfig& c) {
     m->read("compliance_coefficient_per_k", t.compliance_coefficient_per_k);
     m->finish();
   }
+  if (auto m = p.optional_map("aging")) {
+    AgingConfig& a = c.aging;
+    m->read("enabled", a.enabled);
+    m->read("polarisation_loss_per_h", a.polarisation_loss_per_h);
+    m->read("capacitance_loss_per_h", a.capacitance_loss_per_h);
+    m->read("leakage_resistivity_ohm_m", a.leakage_resistivity_ohm_m);
+    m->read("leakage_growth_per_h", a.leakage_growth_per_h);
+    m->read("start_s", a.start_s);
+    m->finish();
+  }
   if (auto m = p.optional_map("mechanics")) {
     m->read("enabled", c.mechanics.enabled);
     m->read("resonance_hz", c.mechanics.resonance_hz);

@@ -57,6 +57,10 @@ bool LoopConfig::is_valid(std::string* why) const {
   }
   if (status_period < 1) return fail("loop.status_period: must be >= 1");
   if (command_capacity < 2) return fail("loop.command_capacity: must be >= 2");
+  if (health_enabled &&
+      (!health.is_valid("health.", why) || !health_bands.is_valid("health.", why))) {
+    return false;
+  }
   return overrun.is_valid(why);
 }
 
@@ -91,6 +95,13 @@ Loop::Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Rec
   if (!config.is_valid(&why)) throw std::invalid_argument(why);
   command_ = safe_command();
   status_.mode = controller_.mode();
+  if (config_.health_enabled) {
+    health_.emplace(config_.health, config_.sample_time);
+    alarms_.emplace(config_.health_bands);
+    status_.health.enabled = true;
+    status_.health.fault = config_.health_bands.fault;
+    status_.health.raised_at_s.fill(-1.0);
+  }
 }
 
 // Whatever the control thread did not collect is freed here (never on the loop thread).
@@ -142,6 +153,7 @@ void Loop::handle(const LoopCommand& c) noexcept {
       return answer(c, CommandResult::kDone);
     }
     case CommandKind::kReset:
+      if (alarms_) static_cast<void>(alarms_->reset());
       if (supervisor_.state() != LoopState::kFaulted) {
         return answer(c, CommandResult::kRefusedState);
       }
@@ -213,6 +225,31 @@ void Loop::publish_adaptation() noexcept {
                         static_cast<std::uint64_t>(adapted_->estimator().updates())};
 }
 
+void Loop::follow_health(bool accepted, double e, double d) noexcept {
+  if (!health_) return;
+  static_cast<void>(health_->step(e, d, accepted));
+  if (cycle_ % config_.status_period == 0) {
+    const bool has_temperature = adapted_ != nullptr;
+    const double temperature = has_temperature ? adapted_->drift().temperature_degc : 0.0;
+    static_cast<void>(
+        alarms_->evaluate(health_->figures(), has_temperature, temperature, health_->time_s()));
+  }
+  if (config_.health_bands.fault && alarms_->active() != 0U) {
+    active_causes_ |= bit(Fault::kHealth);
+    supervisor_.report(Fault::kHealth, cycle_);
+  }
+}
+
+void Loop::publish_health() noexcept {
+  if (!health_) return;
+  HealthStatus& h = status_.health;
+  h.figures = health_->figures();
+  h.active = alarms_->active();
+  h.latched = alarms_->latched();
+  for (std::size_t i = 0; i < adaptation::kHealthAlarmCount; ++i)
+    h.raised_at_s[i] = alarms_->raised_at_s(static_cast<adaptation::HealthAlarm>(i));
+}
+
 double Loop::setpoint() noexcept {
   if (wave_running_ && wave_) {
     const double v = wave_->step();
@@ -277,6 +314,7 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
   } else if (adapted_) {
     adapted_->skip();
   }
+  follow_health(read == DriverStatus::kOk && active_causes_ == 0, in.e, in.d);
   supervisor_.note_cycle(overrun, cycle_, missed);
   if (config_.watchdog_s > 0.0 && supervisor_.armed() && !wave_running_ &&
       static_cast<double>(cycle_ - last_feed_) * config_.sample_time > config_.watchdog_s) {
@@ -320,6 +358,7 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
       status_.fault_records[i] = supervisor_.record(static_cast<Fault>(i));
     status_.driver = driver_->counters();
     publish_adaptation();
+    publish_health();
     published_.publish(status_);
   }
 }

@@ -10,7 +10,7 @@ std::string_view to_string(Fault f) noexcept {
   constexpr std::array<std::string_view, kFaultCount> kNames{
       "power_up",         "driver_error",       "driver_timeout",        "stale_sample",
       "input_not_finite", "input_out_of_range", "estimate_out_of_range", "reconstruction",
-      "overrun",          "watchdog",           "amplifier_fault"};
+      "overrun",          "watchdog",           "amplifier_fault",       "health"};
   const auto i = static_cast<std::size_t>(f);
   return i < kNames.size() ? kNames[i] : std::string_view("unknown");
 }
@@ -27,7 +27,8 @@ std::string_view cause_of(Fault f) noexcept {
       "the model found no unique solution",
       "the loop missed its deadlines beyond safety.overrun",
       "armed on socket setpoints and none arrived within safety.watchdog_s",
-      "the amplifier's fault line"};
+      "the amplifier's fault line",
+      "a health alarm beyond its band (health.fault)"};
   const auto i = static_cast<std::size_t>(f);
   return i < kCauses.size() ? kCauses[i] : std::string_view("unknown");
 }

@@ -150,6 +150,51 @@ TEST(DaemonConfig, TheAdaptationSectionIsReadStrictlyAndValidated) {
   EXPECT_TRUE(has(unknown, "adaptation.forget")) << unknown.problems.front();
 }
 
+// health: plain keys with the estimator's and the bands' defaults, strict, validated under the
+// section's name at the key's line.
+TEST(DaemonConfig, TheHealthSectionIsReadStrictlyAndValidated) {
+  drivers::Registry registry;
+  const ConfigResult shipped = load_config(kConfigDir / "sim.yaml", &registry);
+  ASSERT_TRUE(shipped.ok()) << shipped.problems.front();
+  EXPECT_FALSE(shipped.config.health.enabled);
+  EXPECT_EQ(shipped.config.health.estimator, adaptation::HealthEstimatorConfig{});
+  EXPECT_EQ(shipped.config.health.bands, adaptation::HealthBands{});
+  EXPECT_FALSE(shipped.config.loop_config().health_enabled);
+
+  const ConfigResult on =
+      load_sim("health", {{"  enabled: false                # true: the loop runs the health",
+                           "  enabled: true                 # true: the loop runs the health"},
+                          {"  fault: false ", "  fault: true  "},
+                          {"max_depolarisation_pct: 3.0", "max_depolarisation_pct: 4.5"},
+                          {"baseline_cycles: 20", "baseline_cycles: 7"}});
+  ASSERT_TRUE(on.ok()) << on.problems.front();
+  EXPECT_TRUE(on.config.health.enabled);
+  EXPECT_TRUE(on.config.health.bands.fault);
+  EXPECT_EQ(on.config.health.bands.max_depolarisation_pct, 4.5);
+  EXPECT_EQ(on.config.health.estimator.baseline_cycles, 7U);
+  const runtime::LoopConfig lc = on.config.loop_config();
+  EXPECT_TRUE(lc.health_enabled);
+  EXPECT_TRUE(lc.health_bands.fault);
+  EXPECT_EQ(lc.health.baseline_cycles, 7U);
+
+  const ConfigResult slope =
+      load_sim("health-slope", {{"slope_time_s: 600.0", "slope_time_s: 10.0"}});
+  EXPECT_TRUE(has(slope, ".test-health-slope.yaml:")) << slope.problems.front();
+  EXPECT_TRUE(has(slope, "health.slope_time_s: must be > trend_time_s")) << slope.problems.front();
+  const ConfigResult band =
+      load_sim("health-band", {{"max_depolarisation_pct: 3.0", "max_depolarisation_pct: 120"}});
+  EXPECT_TRUE(has(band, "health.max_depolarisation_pct: must be in (0, 100)"))
+      << band.problems.front();
+  const ConfigResult rho = load_sim(
+      "health-rho", {{"min_leakage_resistivity_ohm_m: 1.0e9", "min_leakage_resistivity_ohm_m: 0"}});
+  EXPECT_TRUE(has(rho, "health.min_leakage_resistivity_ohm_m: must be finite and > 0"))
+      << rho.problems.front();
+  const ConfigResult unknown = load_sim("health-unknown", {{"  dissipation_per_k: -4.0e-3",
+                                                            "  dissipation_per_k: -4.0e-3\n"
+                                                            "  humidity: 3"}});
+  EXPECT_TRUE(has(unknown, "health.humidity")) << unknown.problems.front();
+}
+
 // The simulated stack's temperature ramp needs the plant's temperature model.
 TEST(DaemonConfig, TheSimulatedTemperatureRampIsReadAndChecked) {
   const ConfigResult r =
@@ -162,6 +207,12 @@ TEST(DaemonConfig, TheSimulatedTemperatureRampIsReadAndChecked) {
                     "plant: plant/temperature.yaml\n  temperature: {end_degc: 45, ramp_s: -1}"}});
   EXPECT_TRUE(has(neg, "driver.temperature: start_degc, end_degc must be finite and ramp_s"))
       << (neg.ok() ? "" : neg.problems.front());
+  const ConfigResult swing = load_sim(
+      "swing",
+      {{"plant: plant/daemon.yaml",
+        "plant: plant/temperature.yaml\n  temperature: {swing_degc: 5, swing_period_s: 0}"}});
+  EXPECT_TRUE(has(swing, "driver.temperature: swing_degc must be finite and swing_period_s"))
+      << (swing.ok() ? "" : swing.problems.front());
 }
 
 }  // namespace

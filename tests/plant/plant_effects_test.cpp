@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "plant_test_util.hpp"
@@ -301,6 +302,42 @@ TEST(PlantEffects, TemperatureChangesTheCoefficientsOnlyWhenOn) {
   EXPECT_NEAR(hot.s / strain, 1.0, 1e-12);
   EXPECT_NEAR(hot.t_pa / stress, 1.0, 1e-12);
   EXPECT_NEAR(hot.d_c_per_m2 / (2.0e-8 * (1.0 + 50.0 * 4e-3) * 1.0e6 + d * stress), 1.0, 1e-12);
+}
+
+// Aging (config.hpp AgingConfig): from start_s the coupling d (and the loops) lose
+// polarisation_loss_per_h and the permittivity capacitance_loss_per_h, linearly in time; the
+// leakage's charge sum(n A sigma(t) E Ts) reaches the charge amplifier. Off: nothing changes.
+TEST(PlantEffects, AgingLowersCouplingAndCapacitanceAndLeaksChargeOnlyWhenOn) {
+  PlantConfig c{};
+  c.sample_rate_hz = 10.0;
+  c.aging.polarisation_loss_per_h = 0.05;
+  c.aging.capacitance_loss_per_h = 0.02;
+  c.aging.start_s = 600.0;
+  const std::vector<double> held(42001, 1.0e6);  // 4200 s at 1 MV/m, free stack
+  const std::vector<StepOutput> off = run_field(c, held);
+  c.aging.enabled = true;
+  const std::vector<StepOutput> on = run_field(c, held);
+  EXPECT_DOUBLE_EQ(off.back().s, off[6000].s);
+  EXPECT_DOUBLE_EQ(on[6000].s, off[6000].s);  // not yet aging at 600 s
+  EXPECT_NEAR(on.back().s / off.back().s, 0.95, 1e-9);
+  EXPECT_NEAR(on.back().d_c_per_m2 / off.back().d_c_per_m2, 0.98, 1e-9);
+  // Leakage: rho 1e10 Ohm m, the conductivity doubling per hour from the start.
+  PlantConfig l{};
+  l.sample_rate_hz = 10.0;
+  l.aging.enabled = true;
+  l.aging.leakage_resistivity_ohm_m = 1e10;
+  l.aging.leakage_growth_per_h = 1.0;
+  const std::vector<StepOutput> leak = run_field(l, std::vector<double>(36001, 1.0e6));
+  // sum over k = 0 .. n-1 of (1 + t_k / 3600) / rho E Ts, t_k = k Ts: about 1.5 E 3600 / rho.
+  double expected = 0.0;
+  for (int k = 0; k <= 36000; ++k)
+    expected += (1.0 + k * 0.1 / 3600.0) / 1e10 * 1.0e6 * 0.1;
+  EXPECT_NEAR((leak.back().d_meas_c_per_m2 - leak.back().d_c_per_m2) / expected, 1.0, 1e-6);
+  EXPECT_DOUBLE_EQ(off.back().d_meas_c_per_m2, off.back().d_c_per_m2);
+  std::string why;
+  l.aging.start_s = -1.0;
+  EXPECT_FALSE(l.is_valid(&why));
+  EXPECT_NE(why.find("plant.aging.start_s"), std::string::npos) << why;
 }
 
 // The stress-dependent coefficients see the stress of the same sample: the recorded S, T and D

@@ -2,7 +2,8 @@
 // control mode, with a wave, faults, resets and model swaps, make no heap allocation, with a
 // hysteresis-creep model and with the daemon's shipped Preisach-class model; and the same with
 // the adapted reconstruction (adaptation/adapted_reconstruction.hpp), learning, frozen and
-// resumed through the command ring, a swap refused.
+// resumed through the command ring, a swap refused; and with the health estimate and its
+// alarms (adaptation/health_estimator.hpp) stepped in every cycle.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -33,7 +34,8 @@ class CountingSink final : public SampleSink {
   LoopSample last_{};
 };
 
-void every_mode_without_allocating(const models::TransducerModel& model, bool adapt = false) {
+void every_mode_without_allocating(const models::TransducerModel& model, bool adapt = false,
+                                   bool health = false) {
   constexpr double kTs = 1e-4;
   plant::PlantConfig pc;
   pc.sample_rate_hz = 1e4;
@@ -56,6 +58,15 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
   lc.stress_max = 1e9;
   lc.strain_min = -1.0;
   lc.strain_max = 1.0;
+  if (health) {  // bands so narrow that alarms latch (as warnings) and resets clear them
+    lc.health_enabled = true;
+    lc.health.baseline_cycles = 2;
+    lc.health.hold_settle_s = 0.1;
+    lc.health.hold_window_s = 0.2;
+    lc.health_bands.max_depolarisation_pct = 1e-6;
+    lc.health_bands.max_temperature_degc = -100.0;
+    lc.health_bands.min_leakage_resistivity_ohm_m = 1e30;
+  }
   CountingSink sink;
   std::unique_ptr<Loop> loop_owner =
       adapt ? std::make_unique<Loop>(lc, driver,
@@ -173,6 +184,14 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
     EXPECT_GT(frozen_updates, 50U);
     EXPECT_TRUE(std::isfinite(a.temperature_degc));
   }
+  const HealthStatus& h = loop.local_status().health;
+  EXPECT_EQ(h.enabled, health);
+  if (health) {
+    EXPECT_GT(h.figures.cycles, 0U);
+    EXPECT_TRUE(h.figures.has_capacitance);
+    EXPECT_NE(h.latched, 0U);
+    EXPECT_EQ(loop.supervisor().record(Fault::kHealth).count, 0U);  // warnings, not faults
+  }
 }
 
 TEST(LoopRealTime, CyclesInEveryModeDoNotAllocate) {
@@ -197,6 +216,16 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithAdaptationAndTheShippedPrei
   every_mode_without_allocating(
       models::load_model(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config/models/sim.yaml"),
       true);
+}
+
+TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithHealth) {
+  every_mode_without_allocating(test::typical_transducer(1e-3), false, true);
+}
+
+TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithHealthAndAdaptation) {
+  every_mode_without_allocating(
+      models::load_model(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config/models/sim.yaml"),
+      true, true);
 }
 
 }  // namespace

@@ -40,6 +40,14 @@
 //     learn_loop, min_field_step_v_per_m, max_interval_s, memory_updates, initial_variance,
 //     max_relative_change, reference_degc, permittivity_per_k, loop_per_k, coupling_per_k,
 //     compliance_per_k, load_stiffness_ratio   # adaptation::DriftEstimatorConfig's keys
+//   health:                             # health from E and D, alarms (docs/health.md)
+//     enabled: false                    # true: the loop runs adaptation::HealthEstimator
+//     fault: false                      # true: an alarm is also a fault (safe output)
+//     max_temperature_degc, max_depolarisation_pct, min_leakage_resistivity_ohm_m  # the bands
+//     reversal_field_v_per_m, settle_s, baseline_cycles, span_tolerance, hold_field_v_per_m,
+//     hold_settle_s, hold_window_s, min_hold_field_v_per_m, trend_time_s, slope_time_s,
+//     capacitance_per_k, dissipation_per_k, depolarisation_sensitivity
+//                                       # adaptation::HealthEstimatorConfig's keys
 #pragma once
 
 #include <cstdint>
@@ -49,6 +57,8 @@
 #include <vector>
 
 #include "selfsense/adaptation/drift_estimator.hpp"
+#include "selfsense/adaptation/health_alarms.hpp"
+#include "selfsense/adaptation/health_estimator.hpp"
 #include "selfsense/control/filter_design.hpp"
 #include "selfsense/io/yaml_map.hpp"
 #include "selfsense/runtime/controller.hpp"
@@ -126,6 +136,14 @@ struct AdaptationSection {
   friend bool operator==(const AdaptationSection&, const AdaptationSection&) = default;
 };
 
+// The health estimate and its alarm bands (adaptation/health_estimator.hpp, health_alarms.hpp).
+struct HealthSection {
+  bool enabled{false};
+  adaptation::HealthEstimatorConfig estimator{};
+  adaptation::HealthBands bands{};  // `fault` is the bands'
+  friend bool operator==(const HealthSection&, const HealthSection&) = default;
+};
+
 struct DaemonConfig {
   std::filesystem::path source{};  // the file it was read from
   LoopSection loop{};
@@ -140,6 +158,7 @@ struct DaemonConfig {
   SocketSection socket{};
   TelemetrySection telemetry{};
   AdaptationSection adaptation{};
+  HealthSection health{};
 
   [[nodiscard]] double sample_time() const noexcept { return 1.0 / loop.rate_hz; }
   // The loop's configuration (sample time, safety) from these sections.

@@ -102,6 +102,24 @@ struct TemperatureConfig {
   double compliance_coefficient_per_k{5e-4};
 };
 
+// Aging (issue 24 item 4, docs/health.md), linear in the plant's age from start_s,
+// t_h = max(0, t - start_s) / 3600 s [h]:
+//   a_p(t) = max(0.05, 1 - polarisation_loss_per_h t_h)   scales d and the loop amplitudes of
+//                                                          D and S (the remanent polarisation)
+//   a_c(t) = max(0.05, 1 - capacitance_loss_per_h t_h)    scales the permittivity
+//   sigma(t) = (1 + leakage_growth_per_h t_h) / leakage_resistivity_ohm_m     [S/m]
+// the last an insulation leakage in parallel with the stack: the amplifier delivers, and the
+// charge amplifier counts, q_leak[k] = q_leak[k-1] + n A_el sigma(t) E Ts on top of the
+// stack's charge. leakage_resistivity_ohm_m 0: no leakage. Off by default.
+struct AgingConfig {
+  bool enabled{false};
+  double polarisation_loss_per_h{0.0};    // [1/h] (0.05: 5 % per hour)
+  double capacitance_loss_per_h{0.0};     // [1/h]
+  double leakage_resistivity_ohm_m{0.0};  // at t = 0 [Ohm m]; 0: none
+  double leakage_growth_per_h{0.0};       // relative growth of the conductivity [1/h]
+  double start_s{0.0};                    // the stack ages from this plant time on [s]
+};
+
 // Stack and load as one mass-spring-damper:
 //   m x'' + c x' + (k_s + k_load) x = k_s L S_free + F_ext,   k_s = A_mech / (s^E L),
 // m = (k_s + k_load) / (2 pi resonance_hz)^2, c = 2 zeta sqrt((k_s + k_load) m).
@@ -191,6 +209,7 @@ struct PlantConfig {
   ElectrostrictionConfig electrostriction{};
   StressConfig stress{};
   TemperatureConfig temperature{};
+  AgingConfig aging{};
   MechanicsConfig mechanics{};
   ChargeAmplifierConfig charge_amplifier{};
   AmplifierConfig amplifier{};

@@ -6,14 +6,16 @@
 //   1. amplifier:  u = Amp[E_cmd h]                         (range, slew, current limit)
 //   2. field:      E = u / h
 //   3. polarisation: p = Preisach[E]                         (hysteresis)
-//   4. free response, coefficients c(temp, T) at the input temperature and the stack stress T:
+//   4. free response, coefficients c(temp, T, t) at the input temperature, the stack stress T and
+//      the plant's age t (aging: AgingConfig):
 //        S_i = d(T) E + a_S(T) (p - p0),  S_free = S_i + Creep_S[S_i]
 //   5. mechanics:  x = MSD[x_eq(S_free)],  S = x / L,  T = (S - S_free) / s^E
 //      Steps 4-5 make T a function f of the T that the coefficients see; the plant solves
 //      T = f(T) at every sample (f is affine in T, so two trial evaluations give the root), so
 //      S, T and D of one sample satisfy the constitutive law at one and the same stress.
 //   6. charge:     D_i = eps(E, T) E + a_D(T) (p - p0),  D = D_i + Creep_D[D_i] + d(T) T,
-//                  q = n A_el (D - D(0)),  q_amp = ChargeAmp[q]
+//                  q = n A_el (D - D(0)),  q_amp = ChargeAmp[q + q_leak] (q_leak: the
+//                  insulation leakage's charge, AgingConfig)
 //   7. sensors:    E_meas = Ch_E[E],  D_meas = Ch_D[q_amp / (n A_el)],  then faults
 // Randomness comes from one std::mt19937_64 seeded with PlantConfig::seed.
 //
@@ -89,6 +91,7 @@ class Plant final {
     double u_prev_v{0.0};
     double q_prev_c{0.0};
     double capacitance_est_f{0.0};
+    double q_leak_c{0.0};  // charge through the insulation leakage (AgingConfig)
     StepOutput last{};
   };
 

@@ -20,6 +20,13 @@
 // hot swap is refused (kInvalid, handed back): the learned drift is relative to the running
 // model. kAdapt freezes and resumes learning.
 //
+// Health (LoopConfig::health_enabled): the loop steps adaptation::HealthEstimator with the
+// measured E and D of every cycle (a sample with any fault cause in its cycle is passed as
+// rejected) and evaluates the alarm bands (adaptation::HealthAlarms) every status period, with
+// the adaptation's equivalent temperature when it runs. An alarm latches as a warning (status
+// `health`); with bands.fault it is also Fault::kHealth, a cause in every cycle while it is
+// beyond its band. kReset clears the warnings back inside their bands, in any state.
+//
 // Threads: cycle() runs on the real-time thread only. submit(), take_answer(), take_retired()
 // and status() are for one control thread (single producer / single consumer rings), status()
 // for any thread. cycle() is real-time safe: no allocation, lock, exception, blocking call or
@@ -28,9 +35,12 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
+#include "selfsense/adaptation/health_alarms.hpp"
+#include "selfsense/adaptation/health_estimator.hpp"
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/models/runtime_model.hpp"
 #include "selfsense/runtime/controller.hpp"
@@ -60,6 +70,9 @@ struct LoopConfig {
   double watchdog_s{0.0};
   std::uint32_t status_period{100};  // cycles between status snapshots
   std::size_t command_capacity{64};
+  bool health_enabled{false};
+  adaptation::HealthEstimatorConfig health{};
+  adaptation::HealthBands health_bands{};
 
   [[nodiscard]] bool is_valid(std::string* why) const;
 };
@@ -123,11 +136,15 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
   [[nodiscard]] double setpoint() noexcept;
   [[nodiscard]] models::Reconstruction::Estimate estimate(double e, double d) noexcept;
   void publish_adaptation() noexcept;
+  void follow_health(bool accepted, double e, double d) noexcept;
+  void publish_health() noexcept;
 
   LoopConfig config_;
   Driver* driver_;
   std::unique_ptr<models::Reconstruction> model_;
   std::unique_ptr<adaptation::AdaptedReconstruction> adapted_;  // null: no adaptation
+  std::optional<adaptation::HealthEstimator> health_{};         // empty: no health
+  std::optional<adaptation::HealthAlarms> alarms_{};
   Controller controller_;
   SampleSink* sink_;
   Supervisor supervisor_;

@@ -6,6 +6,8 @@
 #include <array>
 #include <cstdint>
 
+#include "selfsense/adaptation/health_alarms.hpp"
+#include "selfsense/adaptation/health_estimator.hpp"
 #include "selfsense/models/sample_status.hpp"
 #include "selfsense/runtime/driver.hpp"
 #include "selfsense/runtime/loop_sample.hpp"
@@ -23,6 +25,16 @@ struct AdaptationStatus {
   std::uint64_t updates{0};      // RLS updates since the start (or the restored state's)
 };
 
+// The health estimate (adaptation/health_estimator.hpp) and its alarms (health_alarms.hpp).
+struct HealthStatus {
+  bool enabled{false};
+  bool fault{false};  // an alarm is a fault of the loop too (health.fault)
+  adaptation::HealthFigures figures{};
+  std::uint32_t active{0};   // alarm bits beyond their bands now
+  std::uint32_t latched{0};  // alarm bits latched until a reset
+  std::array<double, adaptation::kHealthAlarmCount> raised_at_s{};  // loop time; < 0: not latched
+};
+
 struct StatusSnapshot {
   std::int64_t cycle{0};
   LoopSample last{};
@@ -38,6 +50,7 @@ struct StatusSnapshot {
   std::uint64_t model_swaps{0};
   bool wave_running{false};
   AdaptationStatus adaptation{};
+  HealthStatus health{};
   // Timing, filled by the thread that runs the loop (runtime/loop_runner).
   std::int64_t overruns{0};
   std::int64_t missed_periods{0};

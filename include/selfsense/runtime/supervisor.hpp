@@ -38,6 +38,7 @@ enum class Fault : std::uint8_t {
   kOverrun,             // overrun policy tripped
   kWatchdog,            // armed with socket setpoints and none arrived within the timeout
   kAmplifierFault,      // the amplifier or its fault line
+  kHealth,              // a health alarm with health.fault true (adaptation/health_alarms.hpp)
   kCount
 };
 inline constexpr std::size_t kFaultCount = static_cast<std::size_t>(Fault::kCount);

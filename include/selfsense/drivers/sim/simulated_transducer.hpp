@@ -21,6 +21,7 @@
 // Temperature (the driver section's `temperature: {start_degc, end_degc, ramp_s}`): the stack's
 // temperature at loop time t = cycles * Ts since activate() [degC],
 //   theta(t) = start + (end - start) min(1, t / ramp_s)     (ramp_s 0: end from the start)
+//              + swing_degc sin(2 pi t / swing_period_s)      (swing_degc 0: none)
 // fed to the plant's temperature model (plant.temperature, which must be enabled): a stack that
 // warms while the daemon runs, for the online adaptation (docs/adaptation.md). Default 25 degC.
 //
@@ -42,7 +43,9 @@ namespace selfsense::drivers {
 struct TemperatureRamp {
   double start_degc{25.0};
   double end_degc{25.0};
-  double ramp_s{0.0};  // [s] >= 0
+  double ramp_s{0.0};            // [s] >= 0
+  double swing_degc{0.0};        // amplitude of a sine on top of the ramp [K]
+  double swing_period_s{600.0};  // its period [s] > 0
   friend bool operator==(const TemperatureRamp&, const TemperatureRamp&) = default;
 };
 

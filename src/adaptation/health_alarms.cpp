@@ -1,0 +1,65 @@
+#include "selfsense/adaptation/health_alarms.hpp"
+
+#include <cmath>
+
+namespace selfsense::adaptation {
+
+std::string_view to_string(HealthAlarm a) noexcept {
+  switch (a) {
+    case HealthAlarm::kOverheating:
+      return "overheating";
+    case HealthAlarm::kDepolarisation:
+      return "depolarisation";
+    case HealthAlarm::kInsulation:
+      return "insulation";
+    case HealthAlarm::kCount:
+      break;
+  }
+  return "unknown";
+}
+
+bool HealthBands::is_valid(const std::string& prefix, std::string* why) const {
+  const auto fail = [&](const char* message) {
+    if (why != nullptr) *why = prefix + message;
+    return false;
+  };
+  if (!std::isfinite(max_temperature_degc)) return fail("max_temperature_degc: must be finite");
+  if (!(max_depolarisation_pct > 0.0 && max_depolarisation_pct < 100.0)) {
+    return fail("max_depolarisation_pct: must be in (0, 100)");
+  }
+  if (!(std::isfinite(min_leakage_resistivity_ohm_m) && min_leakage_resistivity_ohm_m > 0.0)) {
+    return fail("min_leakage_resistivity_ohm_m: must be finite and > 0");
+  }
+  return true;
+}
+
+std::uint32_t HealthAlarms::evaluate(const HealthFigures& f, bool has_temperature,
+                                     double temperature_degc, double t_s) noexcept {
+  std::uint32_t now = 0;
+  if (has_temperature && temperature_degc > bands_.max_temperature_degc) {
+    now |= bit(HealthAlarm::kOverheating);
+  }
+  if (f.has_depolarisation && 100.0 * f.depolarisation > bands_.max_depolarisation_pct) {
+    now |= bit(HealthAlarm::kDepolarisation);
+  }
+  if (f.has_leakage && f.leakage_resistivity_ohm_m < bands_.min_leakage_resistivity_ohm_m) {
+    now |= bit(HealthAlarm::kInsulation);
+  }
+  for (std::size_t i = 0; i < kHealthAlarmCount; ++i) {
+    const std::uint32_t b = 1U << i;
+    if ((now & b) != 0U && (latched_ & b) == 0U) raised_at_s_[i] = t_s;
+  }
+  active_ = now;
+  latched_ |= now;
+  return now;
+}
+
+std::uint32_t HealthAlarms::reset() noexcept {
+  latched_ &= active_;
+  for (std::size_t i = 0; i < kHealthAlarmCount; ++i) {
+    if ((latched_ & (1U << i)) == 0U) raised_at_s_[i] = -1.0;
+  }
+  return latched_;
+}
+
+}  // namespace selfsense::adaptation
