@@ -17,14 +17,22 @@
 #endif
 
 #include "commands.hpp"
-#include "diagnose_report.hpp"
 #include "field_signals.hpp"
 #include "model_runs.hpp"
 #include "selfsense/diagnosis/diagnosis.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
+#include "selfsense/report/diagnose_report.hpp"
 
 namespace selfsense::cli {
+
+using report::ReportChannel;
+using report::ReportCorrelation;
+using report::ReportFigure;
+using report::ReportFinding;
+using report::ReportInput;
+using report::ReportSegment;
+using report::write_diagnosis_report;
 namespace {
 
 struct DiagnoseOptions {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace selfsense::cli {
+namespace selfsense::report {
 
 struct ReportSegment {
   double t_start{0.0};  // [s]
@@ -86,4 +86,4 @@ struct ReportInput {
 // for 1e6-sample recordings.
 void write_diagnosis_report(const ReportInput& input, const std::filesystem::path& path);
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::report

@@ -8,6 +8,8 @@
 // measured E, D, the true S, T and the plant's status bits in the input registers. Requests are
 // answered between updates from the register tables; a register outside the map gets the
 // exception response "illegal data address". SIGINT and SIGTERM end it with status 0.
+#include "selfsense/drivers/modbus_sim/modbus_sim_device.hpp"
+
 #include <modbus.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -31,12 +33,11 @@
 #include "selfsense/drivers/modbus/register_map.hpp"
 #include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
-#include "sim_device.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::drivers::modbus_sim {
 namespace {
 
-namespace mb = drivers::modbus;
+namespace mb = modbus;
 
 volatile std::sig_atomic_t g_stop = 0;  // NOLINT: written by the signal handler only
 
@@ -108,7 +109,7 @@ struct Span {
 // The plant behind the register tables.
 class Device final {
  public:
-  Device(const SimDeviceOptions& options, mb::RegisterMap map)
+  Device(const ModbusSimDeviceOptions& options, mb::RegisterMap map)
       : map_(map),
         transducer_(plant::load_plant_file(options.plant).plant),
         period_ns_(std::llround(1e9 / options.rate_hz)) {
@@ -243,7 +244,7 @@ std::int64_t run_due_updates(Device& device, std::int64_t next) {
 
 }  // namespace
 
-int serve_modbus_tcp(const SimDeviceOptions& options, const std::string& host, int port) {
+int serve_modbus_tcp(const ModbusSimDeviceOptions& options, const std::string& host, int port) {
   const StopSignals signals;
   Device device(options, mb::default_register_map());
   set_priority(options.priority);
@@ -308,7 +309,7 @@ int serve_modbus_tcp(const SimDeviceOptions& options, const std::string& host, i
   return 0;
 }
 
-int serve_modbus_rtu(const SimDeviceOptions& options, const std::string& device_path) {
+int serve_modbus_rtu(const ModbusSimDeviceOptions& options, const std::string& device_path) {
   const StopSignals signals;
   Device device(options, mb::default_register_map());
   set_priority(options.priority);
@@ -345,4 +346,4 @@ int serve_modbus_rtu(const SimDeviceOptions& options, const std::string& device_
   return 0;
 }
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::drivers::modbus_sim
