@@ -30,6 +30,7 @@
 #include "selfsense/drivers/can/can_codec.hpp"
 #include "selfsense/plant/plant.hpp"
 #include "selfsense/runtime/latency_histogram.hpp"
+#include "selfsense/runtime/monotonic.hpp"
 
 namespace selfsense::drivers::can_sim {
 namespace {
@@ -48,12 +49,6 @@ void install_stop_handlers() {
   g_stop = 0;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
-}
-
-std::int64_t mono_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
 std::int64_t real_ns() {
@@ -246,15 +241,14 @@ void CanNode::print_summary() const {
 // is counted, and more than ten periods behind the schedule starts again from now.
 void run_paced(CanNode& node, double rate_hz, double duration_s) {
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
-  const std::int64_t start = mono_ns();
+  const std::int64_t start = runtime::monotonic_ns();
   const std::int64_t end =
       duration_s > 0.0 ? start + static_cast<std::int64_t>(duration_s * 1e9) : 0;
   std::int64_t next = start + period_ns;
   while (g_stop == 0) {
-    timespec deadline{static_cast<time_t>(next / 1'000'000'000),
-                      static_cast<long>(next % 1'000'000'000)};
-    if (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) != 0) continue;
-    const std::int64_t now = mono_ns();
+    // A signal ends the sleep early: look at the stop flag before the next tick.
+    if (runtime::sleep_once_until(next) != runtime::Wake::kDeadline) continue;
+    const std::int64_t now = runtime::monotonic_ns();
     if (end != 0 && now >= end) break;
     if (now - next > period_ns) {
       node.count_late();
