@@ -1,4 +1,4 @@
-// `selfsense diagnose` (contracts.md): locate where a model and a recording differ, name the
+// `selfsense diagnose` (docs/diagnose.md): locate where a model and a recording differ, name the
 // physics the model leaves out, model it, write the improved model, the JSON result and the
 // HTML report, with the fit before and after on the recording and on --validate data.
 #include <CLI/CLI.hpp>

@@ -1,7 +1,7 @@
 // `selfsense sim-device --can IFACE | --modbus-tcp HOST:PORT | --modbus-rtu DEVICE [...]`
-// (contracts.md, "simulated device"): the simulated transducer served over a bus, paced in real
-// time, until SIGINT or SIGTERM (exit 0) or --duration. This file parses the options, reads the
-// files the CAN node needs and dispatches to the chosen bus's server (drivers/can_sim,
+// (docs/drivers/can.md, docs/drivers/modbus.md): the simulated transducer served over a bus, paced
+// in real time, until SIGINT or SIGTERM (exit 0) or --duration. This file parses the options, reads
+// the files the CAN node needs and dispatches to the chosen bus's server (drivers/can_sim,
 // drivers/modbus_sim).
 #include <CLI/CLI.hpp>
 #include <cstdio>

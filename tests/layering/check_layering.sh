@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The build's layering, as a check that fails (architecture.md): every header and source of a
+# The build's layering, as a check that fails (docs/architecture.md): every header and source of a
 # library, a driver (drivers/) and the programs (src/cli, src/selfsensed) may include project
 # headers only from the libraries it is allowed to depend on, and the pure-math libraries include
 # nothing that does files, threads, sockets or formats.

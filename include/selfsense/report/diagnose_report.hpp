@@ -1,6 +1,6 @@
-// The HTML report of `selfsense diagnose` (contracts.md): one self-contained file, inline SVG
-// plots, no scripts or network resources. The diagnosis fills ReportInput; this file only
-// draws it.
+// The HTML report of `selfsense diagnose` (docs/diagnose-report.md): one self-contained file,
+// inline SVG plots, no scripts or network resources. The diagnosis fills ReportInput; this file
+// only draws it.
 #pragma once
 
 #include <filesystem>

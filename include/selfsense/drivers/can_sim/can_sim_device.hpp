@@ -1,5 +1,5 @@
 // `selfsense sim-device --can IFACE`: the simulated transducer (selfsense::plant) served as a CAN
-// node (contracts.md, "simulated device"), the far end of the CAN driver (drivers/can). Not part
+// node (docs/drivers/can.md), the far end of the CAN driver (drivers/can). Not part
 // of the daemon. The command reads the daemon configuration (the frame layout) and the plant's
 // file; this library serves them.
 #pragma once
