@@ -27,9 +27,14 @@ rm -f "$out/faults.txt"
 # shellcheck source=scripts/daemon_runs.sh
 source "$root/scripts/daemon_runs.sh"
 
-# start_daemon SHIPPED_CONFIG: the configuration with this run's paths (beside the shipped one,
-# so its relative paths resolve), checked, and selfsensed started on it; waits for its socket.
-config=$root/config/.main-job-$$.yaml
+# start_daemon SHIPPED_CONFIG: the configuration with this run's paths, checked, and selfsensed
+# started on it; waits for its socket. The copy is written into OUT_DIR/config, never into the
+# source tree: models/ and plant/ there are links to the shipped ones, so its relative paths
+# (model: models/sim.yaml, plant: plant/daemon.yaml) resolve as the shipped file's do.
+mkdir -p "$out/config"
+ln -sfn "$root/config/models" "$out/config/models"
+ln -sfn "$root/config/plant" "$out/config/plant"
+config=$out/config/main-job.yaml
 pid=
 start_daemon() {
   sed -e "s|directory: ../build/[a-z-]*/recordings|directory: $out/recordings|" \

@@ -15,20 +15,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <utility>
 #include <vector>
 
 #include "selfsense/base/errno_text.hpp"
+#include "selfsense/runtime/monotonic.hpp"
 
 namespace selfsense::drivers::can {
 namespace {
-
-std::int64_t now_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 canid_t wire_id(const FrameId& f) noexcept {
   return f.extended ? (f.id & CAN_EFF_MASK) | CAN_EFF_FLAG : f.id & CAN_SFF_MASK;
@@ -152,7 +146,7 @@ bool CanDriver::activate(std::string* why) {
   command_seq_ = 0;
   sent_seq_ = 0;
   command_.publish(CanCommand{});
-  activated_ns_ = now_ns();
+  activated_ns_ = runtime::monotonic_ns();
   read_ns_ = activated_ns_;
   thread_ = std::thread([this] { bus_loop(); });
   priority_granted_ = true;
@@ -179,7 +173,7 @@ void CanDriver::bus_loop() noexcept {
     for (;;) {
       const ssize_t n = ::recv(socket_, &frame, sizeof(frame), MSG_DONTWAIT);
       if (n < 0) break;
-      const std::int64_t t = now_ns();
+      const std::int64_t t = runtime::monotonic_ns();
       if (n != static_cast<ssize_t>(CAN_MTU) && n != static_cast<ssize_t>(CANFD_MTU)) {
         bump(n_.bad_data);
         continue;
@@ -249,7 +243,7 @@ void CanDriver::on_frame(const canfd_frame& frame, std::int64_t now) noexcept {
 runtime::DriverStatus CanDriver::read(runtime::InputSample& out) noexcept {
   if (!active_) return runtime::DriverStatus::kNotActive;
   bump(n_.reads);
-  const std::int64_t now = now_ns();
+  const std::int64_t now = runtime::monotonic_ns();
   read_ns_ = now;
   CanInputs in{};
   for (int i = 0; i < kReadAttempts; ++i) {
@@ -290,7 +284,7 @@ runtime::DriverStatus CanDriver::read(runtime::InputSample& out) noexcept {
 
 runtime::DriverStatus CanDriver::write(const runtime::OutputCommand& command) noexcept {
   if (!active_) return runtime::DriverStatus::kNotActive;
-  const std::int64_t now = now_ns();
+  const std::int64_t now = runtime::monotonic_ns();
   command_.publish(CanCommand{command.e, ++command_seq_, read_ok_ ? last_.newest_ns : 0, now});
   // Wakes the bus thread: adds 1 to the eventfd's counter. Never blocks (non-blocking; the
   // counter would need 2^64 - 2 unread wakes to be full).
@@ -333,7 +327,7 @@ void CanDriver::send_command() noexcept {
   if (c.seq > sent_seq_ + 1 && sent_seq_ != 0) n_.superseded.fetch_add(c.seq - sent_seq_ - 1);
   sent_seq_ = c.seq;
   if (!send_frame(c.e)) return;
-  const std::int64_t now = now_ns();
+  const std::int64_t now = runtime::monotonic_ns();
   tx_latency_.record(now - c.handed_ns);
   if (c.inputs_ns != 0) rx_to_tx_.record(now - c.inputs_ns);
 }

@@ -8,34 +8,16 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
-#include <ctime>
 #include <span>
 #include <utility>
+
+#include "selfsense/runtime/monotonic.hpp"
 
 namespace selfsense::drivers::modbus {
 namespace {
 
 constexpr int kMaxReadRegisters = 125;  // one read transaction (Modbus application protocol)
 constexpr std::int64_t kCommandPollNs = 10'000;
-
-std::int64_t now_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-timespec to_timespec(std::int64_t ns) noexcept {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(ns / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(ns % 1'000'000'000);
-  return ts;
-}
-
-void sleep_until(std::int64_t deadline_ns) noexcept {
-  const timespec ts = to_timespec(deadline_ns);
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
-}
 
 void update_max(std::atomic<std::uint64_t>& max, std::uint64_t value) noexcept {
   if (value > max.load(std::memory_order_relaxed)) max.store(value, std::memory_order_relaxed);
@@ -163,7 +145,7 @@ runtime::DriverStatus ModbusDriver::read(runtime::InputSample& out) noexcept {
   if (samples_.try_read(s) && s.seq != held_.seq && s.seq != 0) held_ = s;
   out = held_.in;
   if (!connected_.load(std::memory_order_acquire)) return runtime::DriverStatus::kDisconnected;
-  const std::int64_t age = now_ns() - held_.received_ns;
+  const std::int64_t age = runtime::monotonic_ns() - held_.received_ns;
   if (held_.seq == 0 || age > sample_timeout_ns_) return runtime::DriverStatus::kTimeout;
   if (held_.bad) return runtime::DriverStatus::kBadData;
   if (age > max_age_ns_) {
@@ -217,9 +199,10 @@ BusStats ModbusDriver::bus_stats() const noexcept {
 
 void ModbusDriver::sleep_for_ns(std::int64_t ns) const noexcept {
   // In slices, so that deactivate() never waits for a long back-off.
-  const std::int64_t end = now_ns() + ns;
-  for (std::int64_t t = now_ns(); t < end && !stop_.load(); t = now_ns()) {
-    sleep_until(std::min(end, t + 10'000'000));
+  const std::int64_t end = runtime::monotonic_ns() + ns;
+  for (std::int64_t t = runtime::monotonic_ns(); t < end && !stop_.load();
+       t = runtime::monotonic_ns()) {
+    runtime::sleep_until(std::min(end, t + 10'000'000));
   }
 }
 
@@ -267,7 +250,7 @@ bool ModbusDriver::count_failure(int err) noexcept {
 }
 
 bool ModbusDriver::poll_inputs(std::uint64_t seq) noexcept {
-  const std::int64_t start = now_ns();
+  const std::int64_t start = runtime::monotonic_ns();
   for (std::size_t i = 0; i < blocks_.size(); ++i) {
     const Block& b = blocks_[i];
     if (!b.used) continue;
@@ -280,7 +263,7 @@ bool ModbusDriver::poll_inputs(std::uint64_t seq) noexcept {
       return false;
     }
   }
-  const std::int64_t done = now_ns();
+  const std::int64_t done = runtime::monotonic_ns();
   Sample s;
   s.seq = seq;
   s.received_ns = done;
@@ -334,7 +317,7 @@ bool ModbusDriver::write_command(const Command& c) noexcept {
   }
   written_seq_ = c.seq;
   if (c.sample_seq == published_seq_ && published_seq_ != 0) {
-    const auto latency = static_cast<std::uint64_t>(now_ns() - published_ns_);
+    const auto latency = static_cast<std::uint64_t>(runtime::monotonic_ns() - published_ns_);
     bump(latencies_);
     latency_ns_sum_.fetch_add(latency, std::memory_order_relaxed);
     update_max(latency_ns_max_, latency);
@@ -352,7 +335,7 @@ void ModbusDriver::run_bus() noexcept {
   auto backoff = static_cast<std::int64_t>(config_.reconnect_min_s * 1e9);
   const auto backoff_max = static_cast<std::int64_t>(config_.reconnect_max_s * 1e9);
   std::uint64_t seq = 0;
-  std::int64_t next = now_ns();
+  std::int64_t next = runtime::monotonic_ns();
   while (!stop_.load()) {
     if (!connected_.load(std::memory_order_relaxed)) {
       if (!connect_bus()) {
@@ -362,14 +345,14 @@ void ModbusDriver::run_bus() noexcept {
         continue;
       }
       backoff = static_cast<std::int64_t>(config_.reconnect_min_s * 1e9);
-      next = now_ns();
+      next = runtime::monotonic_ns();
     }
-    const std::int64_t now = now_ns();
+    const std::int64_t now = runtime::monotonic_ns();
     if (now - next > period_ns_) {
       bump(missed_deadlines_);
       next = now;
     }
-    sleep_until(next);
+    runtime::sleep_until(next);
     next += period_ns_;
     if (failures_in_row_ > 0) bump(retries_);
 
@@ -379,8 +362,8 @@ void ModbusDriver::run_bus() noexcept {
       const std::int64_t wait_end = published_ns_ + period_ns_ / 2;
       Command c;
       while (!stop_.load() && (!commands_.try_read(c) || c.sample_seq < published_seq_) &&
-             now_ns() < wait_end) {
-        sleep_until(now_ns() + kCommandPollNs);
+             runtime::monotonic_ns() < wait_end) {
+        runtime::sleep_until(runtime::monotonic_ns() + kCommandPollNs);
       }
       if (commands_.try_read(c) && c.seq != 0 && c.seq != written_seq_) ok = write_command(c);
     }

@@ -1,4 +1,4 @@
-// `selfsense check-config C.yaml` (contracts.md, "The daemon"): exit 0 and `ok` when the daemon
+// `selfsense check-config C.yaml` (docs/daemon.md): exit 0 and `ok` when the daemon
 // would start with this file; otherwise one line per problem, `FILE:LINE: KEY.PATH: what`, and
 // exit 1.
 #include <CLI/CLI.hpp>

@@ -6,9 +6,14 @@
 #include <stdexcept>
 #include <string>
 
-#include "import_text.hpp"
+#include "selfsense/importers/import_text.hpp"
 
 namespace selfsense::cli {
+
+using importers::parse_number;
+using importers::read_lines;
+using importers::split_cells;
+using importers::trim;
 namespace {
 
 bool all_numbers(const std::vector<std::string_view>& cells) {

@@ -1,4 +1,4 @@
-// `selfsense diagnose` (contracts.md): locate where a model and a recording differ, name the
+// `selfsense diagnose` (docs/diagnose.md): locate where a model and a recording differ, name the
 // physics the model leaves out, model it, write the improved model, the JSON result and the
 // HTML report, with the fit before and after on the recording and on --validate data.
 #include <CLI/CLI.hpp>
@@ -17,14 +17,22 @@
 #endif
 
 #include "commands.hpp"
-#include "diagnose_report.hpp"
 #include "field_signals.hpp"
 #include "model_runs.hpp"
 #include "selfsense/diagnosis/diagnosis.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
+#include "selfsense/report/diagnose_report.hpp"
 
 namespace selfsense::cli {
+
+using report::ReportChannel;
+using report::ReportCorrelation;
+using report::ReportFigure;
+using report::ReportFinding;
+using report::ReportInput;
+using report::ReportSegment;
+using report::write_diagnosis_report;
 namespace {
 
 struct DiagnoseOptions {

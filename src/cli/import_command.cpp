@@ -9,11 +9,18 @@
 #include <string>
 
 #include "commands.hpp"
-#include "import_aixacct.hpp"
-#include "import_columns.hpp"
+#include "selfsense/importers/import_aixacct.hpp"
+#include "selfsense/importers/import_columns.hpp"
 #include "selfsense/io/recording.hpp"
 
 namespace selfsense::cli {
+
+using importers::AixacctImport;
+using importers::AixacctOptions;
+using importers::ColumnsOptions;
+using importers::import_aixacct;
+using importers::import_columns;
+using importers::parse_column_map;
 namespace {
 
 struct AixacctCommand {

@@ -17,11 +17,16 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "main_job_page.hpp"
 #include "selfsense/io/recording.hpp"
+#include "selfsense/report/main_job_page.hpp"
 #include "selfsense/runtime/supervisor.hpp"
 
 namespace selfsense::cli {
+
+using report::kStateFaulted;
+using report::MainJobPage;
+using report::MainJobRun;
+using report::write_main_job_page;
 namespace {
 
 namespace fs = std::filesystem;

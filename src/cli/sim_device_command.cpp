@@ -1,16 +1,22 @@
 // `selfsense sim-device --can IFACE | --modbus-tcp HOST:PORT | --modbus-rtu DEVICE [...]`
-// (contracts.md, "simulated device"): the simulated transducer served over a bus, paced in real
-// time, until SIGINT or SIGTERM (exit 0) or --duration. This file only parses the options and
-// dispatches to the chosen bus's server (sim_device_can.cpp, sim_device_modbus.cpp).
+// (docs/drivers/can.md, docs/drivers/modbus.md): the simulated transducer served over a bus, paced
+// in real time, until SIGINT or SIGTERM (exit 0) or --duration. This file parses the options, reads
+// the files the CAN node needs and dispatches to the chosen bus's server (drivers/can_sim,
+// drivers/modbus_sim).
 #include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
 #include "commands.hpp"
-#include "sim_device.hpp"
-#include "sim_device_can.hpp"
+#include "selfsense/daemon/config.hpp"
+#include "selfsense/drivers/can_sim/can_sim_device.hpp"
+#include "selfsense/drivers/modbus_sim/modbus_sim_device.hpp"
+#include "selfsense/drivers/registry/registry.hpp"
+#include "selfsense/plant_io/plant_yaml.hpp"
 
 namespace selfsense::cli {
 namespace {
@@ -25,7 +31,7 @@ struct SimDeviceArgs {
   std::filesystem::path plant{};
   double rate_hz{1000.0};
   // Modbus.
-  SimDeviceOptions modbus{};
+  drivers::modbus_sim::ModbusSimDeviceOptions modbus{};
   // CAN.
   std::filesystem::path config{};
   double duration_s{0.0};
@@ -34,20 +40,49 @@ struct SimDeviceArgs {
 
 // ---- CAN --------------------------------------------------------------------------------------
 
+int fail(const std::string& message) {
+  static_cast<void>(std::fprintf(stderr, "sim-device: %s\n", message.c_str()));
+  return 1;
+}
+
+// The frame layout: the driver section of a daemon configuration with driver.type can.
+bool read_layout(const SimDeviceArgs& a, drivers::can::CanConfig& layout, int& status) {
+  drivers::Registry registry;
+  const daemon::ConfigResult loaded = daemon::load_config(a.config, &registry);
+  if (!loaded.ok()) {
+    for (const std::string& p : loaded.problems)
+      static_cast<void>(std::fprintf(stderr, "%s\n", p.c_str()));
+    status = fail(a.config.string() + ": not a valid daemon configuration");
+    return false;
+  }
+  if (loaded.config.driver_type != "can") {
+    status = fail(a.config.string() + ": driver.type is '" + loaded.config.driver_type +
+                  "', not can (the CAN node takes its frame layout from a can driver section)");
+    return false;
+  }
+  layout = registry.can_config();
+  if (!a.can.empty()) layout.interface = a.can;
+  return true;
+}
+
 int run_can(const SimDeviceArgs& a) {
   if (a.config.empty()) {
     throw std::runtime_error(
         "sim-device --can: --config C.yaml (a daemon configuration with "
         "driver.type can: the frame layout) is required");
   }
-  CanSimDeviceOptions c;
-  c.interface = a.can;
-  c.config = a.config;
-  c.plant = a.plant;
+  drivers::can_sim::CanSimDeviceOptions c;
+  int status = 0;
+  if (!read_layout(a, c.layout, status)) return status;
+  try {
+    if (!a.plant.empty()) c.plant = plant::load_plant_file(a.plant).plant;
+  } catch (const std::exception& e) {
+    return fail(std::string("--plant: ") + e.what());
+  }
   c.rate_hz = a.rate_hz;
   c.duration_s = a.duration_s;
   c.command_timeout_ms = a.command_timeout_ms;
-  return run_can_sim_device(c);
+  return drivers::can_sim::run_can_sim_device(c);
 }
 
 // ---- Modbus -----------------------------------------------------------------------------------
@@ -68,14 +103,14 @@ std::pair<std::string, int> host_port(const std::string& s) {
 }
 
 int run_modbus(const SimDeviceArgs& a) {
-  SimDeviceOptions o = a.modbus;
+  drivers::modbus_sim::ModbusSimDeviceOptions o = a.modbus;
   if (!a.plant.empty()) o.plant = a.plant;
   o.rate_hz = a.rate_hz;
   if (!a.modbus_tcp.empty()) {
     const auto [host, port] = host_port(a.modbus_tcp);
-    return serve_modbus_tcp(o, host, port);
+    return drivers::modbus_sim::serve_modbus_tcp(o, host, port);
   }
-  return serve_modbus_rtu(o, a.modbus_rtu);
+  return drivers::modbus_sim::serve_modbus_rtu(o, a.modbus_rtu);
 }
 
 int dispatch(const SimDeviceArgs& a) {

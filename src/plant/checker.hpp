@@ -1,11 +1,14 @@
-// Collects the first violated constraint of a configuration as "<prefix><key path>: <value>:
-// <constraint>" (internal to selfsense_plant: config.cpp and excitation.cpp).
+// Collects the first violated constraint of a configuration in the one message format of
+// selfsense/base/check.hpp, "<prefix><key path>: <value> <constraint>" (internal to
+// selfsense_plant: config.cpp and excitation.cpp).
 #pragma once
 
-#include <cmath>
-#include <sstream>
 #include <string>
+#include <string_view>
+#include <type_traits>
 #include <utility>
+
+#include "selfsense/base/check.hpp"
 
 namespace selfsense::plant::detail {
 
@@ -15,23 +18,19 @@ class Checker final {
   [[nodiscard]] bool ok() const { return ok_; }
 
   template <typename T>
-  void require(bool condition, const std::string& path, T value, const std::string& constraint) {
-    if (!ok_ || condition) return;
-    ok_ = false;
-    if (why_ != nullptr) {
-      std::ostringstream out;
-      out << prefix_ << path << ": " << value << ": " << constraint;
-      *why_ = out.str();
-    }
+  requires std::is_arithmetic_v<T>
+  void require(bool condition, const std::string& path, T value, std::string_view constraint) {
+    if (!ok_) return;
+    ok_ = base::check::require(condition, prefix_ + path, value, constraint, why_);
   }
   void positive(const std::string& path, double value) {
-    require(std::isfinite(value) && value > 0.0, path, value, "must be a finite number > 0");
+    if (ok_) ok_ = base::check::positive(prefix_ + path, value, why_);
   }
   void non_negative(const std::string& path, double value) {
-    require(std::isfinite(value) && value >= 0.0, path, value, "must be a finite number >= 0");
+    if (ok_) ok_ = base::check::non_negative(prefix_ + path, value, why_);
   }
   void finite(const std::string& path, double value) {
-    require(std::isfinite(value), path, value, "must be finite");
+    if (ok_) ok_ = base::check::finite(prefix_ + path, value, why_);
   }
 
  private:

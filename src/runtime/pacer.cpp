@@ -2,28 +2,17 @@
 
 #include <algorithm>
 #include <cassert>
-#include <cerrno>
-#include <ctime>
+
+#include "selfsense/runtime/monotonic.hpp"
 
 namespace selfsense::runtime {
-namespace {
-
-constexpr std::int64_t kNsPerS = 1'000'000'000;
-
-}  // namespace
 
 std::int64_t SteadyClock::now_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * kNsPerS + ts.tv_nsec;
+  return monotonic_ns();
 }
 
 void SteadyClock::sleep_until_ns(std::int64_t t) noexcept {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(t / kNsPerS);
-  ts.tv_nsec = static_cast<long>(t % kNsPerS);
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
+  sleep_until(t);
 }
 
 Pacer::Pacer(Clock& clock, std::int64_t period_ns) noexcept

@@ -1,4 +1,4 @@
-// selfsensed: the real-time self-sensing controller daemon (contracts.md, "The daemon").
+// selfsensed: the real-time self-sensing controller daemon (docs/daemon.md).
 //   selfsensed --config C.yaml     foreground; systemd runs it as is (Type=notify)
 // Exits non-zero with every configuration problem named when the file is bad.
 #include <CLI/CLI.hpp>

@@ -1,4 +1,4 @@
-// `selfsense diagnose` end to end through the tool (contracts.md): plant recordings written by
+// `selfsense diagnose` end to end through the tool (docs/diagnose.md): plant recordings written by
 // `selfsense plant`, a base model by `selfsense identify`, then the diagnosis with --validate;
 // the JSON contract, the improved model loaded by simulate and reconstruct, the report, a
 // consistent case and bad input.

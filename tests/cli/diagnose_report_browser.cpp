@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "cli/report_sample.hpp"
-#include "diagnose_report.hpp"
+#include "selfsense/report/diagnose_report.hpp"
 
 namespace {
 
@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
   try {
     const std::vector<std::string> args(argv + 1, argv + argc);
     if (args.size() == 3 && args[0] == "write") {
-      selfsense::cli::write_diagnosis_report(
+      selfsense::report::write_diagnosis_report(
           selfsense::test::make_sample_report(std::stoul(args[2])), args[1]);
       return 0;
     }

@@ -1,6 +1,6 @@
 // The HTML report of `selfsense diagnose`: sections, escaping, well-formed SVG, no NaN text,
 // bounded size for long recordings, and the plot reduction behind it.
-#include "diagnose_report.hpp"
+#include "selfsense/report/diagnose_report.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "cli/report_sample.hpp"
-#include "svg_plot.hpp"
+#include "selfsense/report/svg_plot.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::report {
 namespace {
 
 namespace fs = std::filesystem;
@@ -267,4 +267,4 @@ TEST(HtmlText, EscapesAndFormats) {
 }
 
 }  // namespace
-}  // namespace selfsense::cli
+}  // namespace selfsense::report

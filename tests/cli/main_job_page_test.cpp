@@ -1,6 +1,6 @@
 // The main job's page (main_job_page.hpp): the samples the tracking error is drawn over, the
 // ring-down window, and a page with its axes, legend, error panel and fault marks.
-#include "main_job_page.hpp"
+#include "selfsense/report/main_job_page.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-namespace selfsense::cli {
+namespace selfsense::report {
 namespace {
 
 std::size_t count(std::string_view text, std::string_view what) {
@@ -160,4 +160,4 @@ TEST(MainJobPage, RingDownRunsAndUnreadableRecordings) {
 }
 
 }  // namespace
-}  // namespace selfsense::cli
+}  // namespace selfsense::report

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <vector>
 
-#include "diagnose_report.hpp"
+#include "selfsense/report/diagnose_report.hpp"
 
 namespace selfsense::test {
 
@@ -20,8 +20,8 @@ inline std::vector<double> sample_correlation(std::size_t count, double decay, d
   return out;
 }
 
-inline cli::ReportCorrelation sample_test(const std::string& channel, double scale) {
-  cli::ReportCorrelation c;
+inline report::ReportCorrelation sample_test(const std::string& channel, double scale) {
+  report::ReportCorrelation c;
   c.channel = channel;
   c.max_lag = 25;
   c.autocorrelation = sample_correlation(26, 0.15, 1.0);
@@ -37,8 +37,8 @@ inline cli::ReportCorrelation sample_test(const std::string& channel, double sca
 }
 
 // n samples at 1 kHz.
-inline cli::ReportInput make_sample_report(std::size_t n) {
-  cli::ReportInput in;
+inline report::ReportInput make_sample_report(std::size_t n) {
+  report::ReportInput in;
   in.model_path = "models/<script>alert(1)</script>.yaml";
   in.recording_path = "data/run \"A\" & 'B'.csv";
   in.validate_path = "data/validation.csv";
@@ -58,7 +58,7 @@ inline cli::ReportInput make_sample_report(std::size_t n) {
   const char* units[] = {"-", "C/m^2"};
   const double gains[] = {1.0e-9, 2.0e-8};
   for (std::size_t c = 0; c < 2; ++c) {
-    cli::ReportChannel ch;
+    report::ReportChannel ch;
     ch.name = names[c];
     ch.unit = units[c];
     ch.recorded.resize(n);
@@ -87,7 +87,7 @@ inline cli::ReportInput make_sample_report(std::size_t n) {
   const char* effects[] = {"creep", "charge_leakage"};
   const char* features[] = {"log10 time since last step [s]", "D integral [C s/m^2]"};
   for (std::size_t k = 0; k < 2; ++k) {
-    cli::ReportFinding f;
+    report::ReportFinding f;
     f.effect = effects[k];
     f.channel = names[k];
     f.where = in.channels[k].located;

@@ -1,6 +1,6 @@
 // The reports' axes (svg_plot.hpp): ticks at 1, 2 or 5 times a power of ten, their labels,
 // markers, labelled bands and the legend column.
-#include "svg_plot.hpp"
+#include "selfsense/report/svg_plot.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-namespace selfsense::cli {
+namespace selfsense::report {
 namespace {
 
 std::size_t count(std::string_view text, std::string_view what) {
@@ -119,4 +119,4 @@ TEST(SvgPlotAxes, IncludeXLinesUpStackedPlots) {
 }
 
 }  // namespace
-}  // namespace selfsense::cli
+}  // namespace selfsense::report

@@ -18,7 +18,7 @@ namespace {
 using testing::RunningDaemon;
 
 constexpr double kRate = testing::kProcessTestRate;
-constexpr int kArmed = 2;  // the recording's state column (contracts.md)
+constexpr int kArmed = 2;  // the recording's state column (docs/recorder.md)
 
 TEST(DaemonStop, SigtermWhileArmedRampsToTheSafeOutputThenExitsZero) {
   const testing::ScratchDir dir("daemon-stop");

@@ -15,7 +15,7 @@
 #include <string_view>
 
 #include "fuzz_check.hpp"
-#include "import_aixacct.hpp"
+#include "selfsense/importers/import_aixacct.hpp"
 
 namespace {
 
@@ -40,9 +40,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   input.write(selfsense::fuzz::as_text(data, size));
   const std::string file = input.path().string();
 
-  selfsense::cli::AixacctImport imported;
+  selfsense::importers::AixacctImport imported;
   try {
-    imported = selfsense::cli::import_aixacct(input.path(), selfsense::cli::AixacctOptions{});
+    imported =
+        selfsense::importers::import_aixacct(input.path(), selfsense::importers::AixacctOptions{});
   } catch (const selfsense::io::RecordingError& e) {
     require(
         whole_file_problem(e.what(), file) || selfsense::fuzz::names_file_and_line(e.what(), file),

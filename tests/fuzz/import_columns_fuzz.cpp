@@ -15,18 +15,18 @@
 #include <string_view>
 
 #include "fuzz_check.hpp"
-#include "import_columns.hpp"
+#include "selfsense/importers/import_columns.hpp"
 
 namespace {
 
 using selfsense::fuzz::require;
 
-selfsense::cli::ColumnsOptions options_for(std::uint8_t selector) {
+selfsense::importers::ColumnsOptions options_for(std::uint8_t selector) {
   constexpr std::array<char, 4> kDelimiters = {',', ';', '\t', ' '};
-  selfsense::cli::ColumnsOptions o;
+  selfsense::importers::ColumnsOptions o;
   o.delimiter = kDelimiters.at(selector & 3U);
   o.skip_rows = (selector >> 2U) & 3U;
-  o.map = selfsense::cli::parse_column_map("1:t:ms,2:u:kV,3:q:nC,4:x:um");
+  o.map = selfsense::importers::parse_column_map("1:t:ms,2:u:kV,3:q:nC,4:x:um");
   o.layer_thickness_m = 1e-4;
   o.electrode_area_m2 = 1e-4;
   o.layers = 100.0;
@@ -46,13 +46,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static const selfsense::fuzz::ScratchFile input("in.txt");
   static const selfsense::fuzz::ScratchFile output("out.csv");
   if (size == 0) return 0;
-  const selfsense::cli::ColumnsOptions options = options_for(data[0]);
+  const selfsense::importers::ColumnsOptions options = options_for(data[0]);
   input.write(selfsense::fuzz::as_text(data + 1, size - 1));
   const std::string file = input.path().string();
 
   selfsense::io::Recording r;
   try {
-    r = selfsense::cli::import_columns(input.path(), options);
+    r = selfsense::importers::import_columns(input.path(), options);
   } catch (const selfsense::io::RecordingError& e) {
     require(
         whole_file_problem(e.what(), file) || selfsense::fuzz::names_file_and_line(e.what(), file),

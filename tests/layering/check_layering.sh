@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The build's layering, as a check that fails (architecture.md): every header and source of a
+# The build's layering, as a check that fails (docs/architecture.md): every header and source of a
 # library, a driver (drivers/) and the programs (src/cli, src/selfsensed) may include project
 # headers only from the libraries it is allowed to depend on, and the pure-math libraries include
 # nothing that does files, threads, sockets or formats.
@@ -26,12 +26,16 @@ declare -A allowed=(
   [io]="io base"
   [model_io]="model_io models operators io base"
   [plant_io]="plant_io plant io base"
+  [report]="report base"
+  [importers]="importers io base"
   [runtime]="runtime adaptation models operators control base"
   [daemon]="daemon runtime adaptation models operators control io model_io base"
   [drivers/sim]="drivers/sim runtime models operators control plant base"
   [drivers/can]="drivers/can runtime models operators control io base"
   [drivers/modbus]="drivers/modbus runtime models operators control io base"
   [drivers/spi]="drivers/spi runtime models operators control io base"
+  [drivers/can_sim]="drivers/can_sim drivers/can plant runtime base"
+  [drivers/modbus_sim]="drivers/modbus_sim drivers/modbus drivers/sim runtime plant_io base"
   [drivers/registry]="drivers/registry drivers/sim drivers/can drivers/modbus drivers/spi daemon runtime adaptation models operators control io model_io plant plant_io base"
   [cli]="*"
   [selfsensed]="selfsensed daemon drivers/registry runtime adaptation models operators control io model_io base"

@@ -35,8 +35,8 @@ echo '#include "selfsense/drivers/can/can_driver.hpp"' >"$tmp/src/daemon/daemon.
 expect_failure "the daemon including a driver" "src/daemon/daemon.cpp:1: daemon must not include selfsense/drivers/can"
 rm "$tmp/src/daemon/daemon.cpp"
 
-echo '#include "selfsense/report/svg.hpp"' >"$tmp/src/cli/plot.cpp"
-expect_failure "the tool including an unknown library" "src/cli/plot.cpp:1: cli must not include selfsense/report"
+echo '#include "selfsense/plotting/svg.hpp"' >"$tmp/src/cli/plot.cpp"
+expect_failure "the tool including an unknown library" "src/cli/plot.cpp:1: cli must not include selfsense/plotting"
 rm "$tmp/src/cli/plot.cpp"
 
 mkdir -p "$tmp/drivers/ethercat"

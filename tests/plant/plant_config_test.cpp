@@ -44,7 +44,7 @@ TEST(PlantConfig, ResonanceAboveNyquistNamesTheKey) {
   c.mechanics.enabled = true;
   c.mechanics.resonance_hz = 80000.0;
   EXPECT_EQ(why_invalid(c),
-            "plant.mechanics.resonance_hz: 80000: is above the Nyquist frequency 50000 of "
+            "plant.mechanics.resonance_hz: 80000 is above the Nyquist frequency 50000 of "
             "sample_rate_hz");
 }
 
@@ -156,7 +156,7 @@ TEST(PlantYaml, InvalidValueNamesKeyAndLine) {
       "plant:\n  sample_rate_hz: 100000\n  mechanics:\n    enabled: true\n"
       "    resonance_hz: 80000\n");
   EXPECT_EQ(msg,
-            "P.yaml:5: plant.mechanics.resonance_hz: 80000: is above the Nyquist frequency 50000 "
+            "P.yaml:5: plant.mechanics.resonance_hz: 80000 is above the Nyquist frequency 50000 "
             "of sample_rate_hz");
   EXPECT_NE(load_error("plant:\n  material: {permittivity_f_per_m: -1.0e-8}\n")
                 .find("P.yaml:2: plant.material.permittivity_f_per_m"),
@@ -171,7 +171,7 @@ TEST(PlantYaml, BadFaultKindListsTheChoices) {
 
 TEST(PlantYaml, ExcitationSectionIsStrictToo) {
   EXPECT_EQ(load_error("plant: {}\nexcitation:\n  sines: {cycles: 0}\n"),
-            "P.yaml:3: excitation.sines.cycles: 0: must be >= 1");
+            "P.yaml:3: excitation.sines.cycles: 0 must be >= 1");
   EXPECT_EQ(load_error("plant: {}\nexcitation:\n  steps: {hold: 1}\n"),
             "P.yaml:3: excitation.steps.hold: unknown key");
 }

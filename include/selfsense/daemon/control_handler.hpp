@@ -1,4 +1,4 @@
-// The daemon's answers to control-socket requests (contracts.md, "The daemon"): validated
+// The daemon's answers to control-socket requests (docs/control-socket.md): validated
 // requests (control_protocol.hpp) become loop commands, recorder actions or a status reply.
 // Runs on the control server's thread; never on the real-time thread.
 //

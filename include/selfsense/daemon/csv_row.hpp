@@ -1,4 +1,4 @@
-// Loop samples as rows of a contract recording (shared/docs/contracts.md): the column names,
+// Loop samples as rows of a contract recording (docs/recorder.md, "File format"): the column names,
 // the row text, and the one way a row may be lengthened without changing its meaning.
 //
 // Columns, in this order:

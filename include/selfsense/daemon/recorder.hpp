@@ -116,7 +116,6 @@ class Recorder final {
   struct Request;
   class Writer;
 
-  void run() noexcept;
   std::string request(Request& request);
 
   RecorderConfig config_;

@@ -2,7 +2,7 @@
 // recorder keeps and the telemetry summarises. A plain value (trivially copyable), handed over
 // through lock-free rings (runtime/spsc_ring.hpp).
 //
-// Recording columns (contracts.md, "The daemon"): t, E, D, T_hat, S_hat, setpoint, command,
+// Recording columns (docs/recorder.md, "File format"): t, E, D, T_hat, S_hat, setpoint, command,
 // state, and S, T when the driver has references (the simulated transducer does); the rest are
 // extensions any contract reader carries through.
 #pragma once

@@ -37,7 +37,7 @@ class Clock {
   virtual void sleep_until_ns(std::int64_t t) noexcept = 0;
 };
 
-// CLOCK_MONOTONIC with absolute sleeps (retried on EINTR).
+// CLOCK_MONOTONIC with absolute sleeps, retried after signals (runtime/monotonic.hpp).
 class SteadyClock final : public Clock {
  public:
   [[nodiscard]] std::int64_t now_ns() noexcept override;

@@ -84,7 +84,7 @@ check() {  # check COLUMN LIMIT_PERCENT
 # One CI run measured 0.742 % (S_hat 0.050 %), not reproduced here in 16 runs with and without
 # load. One way to get there was removed: a descheduled device used to drop the periods it
 # missed, so its plant fell behind the wall clock the daemon's model steps by; it now replays
-# them (sim_device_modbus.cpp).
+# them (drivers/modbus_sim/modbus_sim_device.cpp).
 check S_hat 0.065
 check S 0.5
 # A clean run: no exception responses and no bad frames (a timeout or two may happen on a loaded

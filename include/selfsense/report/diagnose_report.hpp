@@ -1,13 +1,13 @@
-// The HTML report of `selfsense diagnose` (contracts.md): one self-contained file, inline SVG
-// plots, no scripts or network resources. The diagnosis fills ReportInput; this file only
-// draws it.
+// The HTML report of `selfsense diagnose` (docs/diagnose-report.md): one self-contained file,
+// inline SVG plots, no scripts or network resources. The diagnosis fills ReportInput; this file
+// only draws it.
 #pragma once
 
 #include <filesystem>
 #include <string>
 #include <vector>
 
-namespace selfsense::cli {
+namespace selfsense::report {
 
 struct ReportSegment {
   double t_start{0.0};  // [s]
@@ -86,4 +86,4 @@ struct ReportInput {
 // for 1e6-sample recordings.
 void write_diagnosis_report(const ReportInput& input, const std::filesystem::path& path);
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::report

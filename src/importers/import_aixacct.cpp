@@ -1,4 +1,4 @@
-#include "import_aixacct.hpp"
+#include "selfsense/importers/import_aixacct.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,10 +8,10 @@
 #include <utility>
 #include <vector>
 
-#include "import_text.hpp"
 #include "selfsense/base/format_number.hpp"
+#include "selfsense/importers/import_text.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::importers {
 namespace {
 
 using base::format_number;
@@ -234,4 +234,4 @@ AixacctImport import_aixacct(const std::filesystem::path& path, const AixacctOpt
   return out;
 }
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::importers

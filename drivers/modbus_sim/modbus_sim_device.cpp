@@ -8,6 +8,8 @@
 // measured E, D, the true S, T and the plant's status bits in the input registers. Requests are
 // answered between updates from the register tables; a register outside the map gets the
 // exception response "illegal data address". SIGINT and SIGTERM end it with status 0.
+#include "selfsense/drivers/modbus_sim/modbus_sim_device.hpp"
+
 #include <modbus.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -31,12 +33,12 @@
 #include "selfsense/drivers/modbus/register_map.hpp"
 #include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
-#include "sim_device.hpp"
+#include "selfsense/runtime/monotonic.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::drivers::modbus_sim {
 namespace {
 
-namespace mb = drivers::modbus;
+namespace mb = modbus;
 
 volatile std::sig_atomic_t g_stop = 0;  // NOLINT: written by the signal handler only
 
@@ -73,12 +75,6 @@ class StopSignals final {
   sigset_t wait_mask_{};
 };
 
-std::int64_t now_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
 struct MappingDeleter {
   void operator()(modbus_mapping_t* m) const noexcept { modbus_mapping_free(m); }
 };
@@ -108,7 +104,7 @@ struct Span {
 // The plant behind the register tables.
 class Device final {
  public:
-  Device(const SimDeviceOptions& options, mb::RegisterMap map)
+  Device(const ModbusSimDeviceOptions& options, mb::RegisterMap map)
       : map_(map),
         transducer_(plant::load_plant_file(options.plant).plant),
         period_ns_(std::llround(1e9 / options.rate_hz)) {
@@ -201,7 +197,7 @@ struct ServerCounts {
 // Waits for bus traffic until the next device update; true when the update is due.
 // Returns false with g_stop set when a signal arrived.
 bool wait_until(std::vector<pollfd>& fds, std::int64_t deadline, const StopSignals& signals) {
-  const std::int64_t left = std::max<std::int64_t>(0, deadline - now_ns());
+  const std::int64_t left = std::max<std::int64_t>(0, deadline - runtime::monotonic_ns());
   timespec ts{static_cast<time_t>(left / 1'000'000'000), static_cast<long>(left % 1'000'000'000)};
   for (pollfd& p : fds)
     p.revents = 0;
@@ -229,7 +225,7 @@ void finish(const Device& device, const ServerCounts& counts) {
 // behind it starts again from now (the missed time is counted, not replayed).
 std::int64_t run_due_updates(Device& device, std::int64_t next) {
   const std::int64_t period = device.period_ns();
-  const std::int64_t now = now_ns();
+  const std::int64_t now = runtime::monotonic_ns();
   if (now - next > 1'000'000'000) {
     device.skip(now - next);
     next = now;
@@ -243,7 +239,7 @@ std::int64_t run_due_updates(Device& device, std::int64_t next) {
 
 }  // namespace
 
-int serve_modbus_tcp(const SimDeviceOptions& options, const std::string& host, int port) {
+int serve_modbus_tcp(const ModbusSimDeviceOptions& options, const std::string& host, int port) {
   const StopSignals signals;
   Device device(options, mb::default_register_map());
   set_priority(options.priority);
@@ -269,7 +265,7 @@ int serve_modbus_tcp(const SimDeviceOptions& options, const std::string& host, i
   std::vector<pollfd> fds{pollfd{listener, POLLIN, 0}};
   std::array<std::uint8_t, MODBUS_TCP_MAX_ADU_LENGTH> query{};
   ServerCounts counts;
-  std::int64_t next = now_ns() + device.period_ns();
+  std::int64_t next = runtime::monotonic_ns() + device.period_ns();
   while (g_stop == 0) {
     if (wait_until(fds, next, signals)) {
       if (g_stop != 0) break;
@@ -308,7 +304,7 @@ int serve_modbus_tcp(const SimDeviceOptions& options, const std::string& host, i
   return 0;
 }
 
-int serve_modbus_rtu(const SimDeviceOptions& options, const std::string& device_path) {
+int serve_modbus_rtu(const ModbusSimDeviceOptions& options, const std::string& device_path) {
   const StopSignals signals;
   Device device(options, mb::default_register_map());
   set_priority(options.priority);
@@ -327,7 +323,7 @@ int serve_modbus_rtu(const SimDeviceOptions& options, const std::string& device_
   std::vector<pollfd> fds{pollfd{modbus_get_socket(ctx.get()), POLLIN, 0}};
   std::array<std::uint8_t, MODBUS_RTU_MAX_ADU_LENGTH> query{};
   ServerCounts counts;
-  std::int64_t next = now_ns() + device.period_ns();
+  std::int64_t next = runtime::monotonic_ns() + device.period_ns();
   while (g_stop == 0) {
     if (!wait_until(fds, next, signals)) {
       const int rc = modbus_receive(ctx.get(), query.data());
@@ -345,4 +341,4 @@ int serve_modbus_rtu(const SimDeviceOptions& options, const std::string& device_
   return 0;
 }
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::drivers::modbus_sim

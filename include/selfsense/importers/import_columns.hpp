@@ -16,7 +16,7 @@
 
 #include "selfsense/io/recording.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::importers {
 
 struct ColumnMap {
   std::size_t column{0};  // 1-based column in the file
@@ -46,4 +46,4 @@ struct ColumnsOptions {
 [[nodiscard]] io::Recording import_columns(const std::filesystem::path& path,
                                            const ColumnsOptions& options);
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::importers

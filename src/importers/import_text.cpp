@@ -1,4 +1,4 @@
-#include "import_text.hpp"
+#include "selfsense/importers/import_text.hpp"
 
 #include <array>
 #include <charconv>
@@ -9,7 +9,7 @@
 
 #include "selfsense/io/recording.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::importers {
 namespace {
 
 struct Unit {
@@ -108,4 +108,4 @@ std::string known_units() {
   return out;
 }
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::importers

@@ -1,4 +1,4 @@
-#include "svg_plot.hpp"
+#include "selfsense/report/svg_plot.hpp"
 
 #include <algorithm>
 #include <array>
@@ -13,7 +13,7 @@
 #include <unordered_set>
 #include <utility>
 
-namespace selfsense::cli {
+namespace selfsense::report {
 namespace {
 
 constexpr int kMarginLeft = 68;
@@ -619,4 +619,4 @@ std::string SvgPlot::render() const {
   return out;
 }
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::report

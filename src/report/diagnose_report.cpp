@@ -1,4 +1,4 @@
-#include "diagnose_report.hpp"
+#include "selfsense/report/diagnose_report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,9 +10,9 @@
 #include <string_view>
 #include <vector>
 
-#include "svg_plot.hpp"
+#include "selfsense/report/svg_plot.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::report {
 namespace {
 
 constexpr std::string_view kRecordedColour = "#222222";
@@ -385,4 +385,4 @@ void write_diagnosis_report(const ReportInput& input, const std::filesystem::pat
   if (!file) throw std::runtime_error("cannot write the report " + path.string());
 }
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::report

@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-namespace selfsense::cli {
+namespace selfsense::report {
 
 // Text for HTML (element content and attribute values): & < > " ' as entities.
 [[nodiscard]] std::string escape_html(std::string_view text);
@@ -122,4 +122,4 @@ class SvgPlot {
   int legend_column_{0};
 };
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::report

@@ -17,7 +17,7 @@
 
 #include "selfsense/io/recording.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::importers {
 
 struct AixacctOptions {
   int block{1};                              // n of "Table <n>" (data blocks only)
@@ -39,4 +39,4 @@ struct AixacctImport {
 [[nodiscard]] AixacctImport import_aixacct(const std::filesystem::path& path,
                                            const AixacctOptions& options);
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::importers

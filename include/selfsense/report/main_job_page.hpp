@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-namespace selfsense::cli {
+namespace selfsense::report {
 
 // Codes of the recording's `state` column (the daemon's recorder).
 inline constexpr double kStateFaulted = 0.0;
@@ -75,4 +75,4 @@ struct RingDownWindow {
 // Throws std::runtime_error naming the path when it cannot be written.
 void write_main_job_page(const MainJobPage& page, const std::filesystem::path& path);
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::report

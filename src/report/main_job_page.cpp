@@ -1,4 +1,4 @@
-#include "main_job_page.hpp"
+#include "selfsense/report/main_job_page.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "svg_plot.hpp"
+#include "selfsense/report/svg_plot.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::report {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -322,4 +322,4 @@ void write_main_job_page(const MainJobPage& page, const std::filesystem::path& p
   if (!file) throw std::runtime_error("cannot write the page " + path.string());
 }
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::report

@@ -1,4 +1,4 @@
-#include "import_columns.hpp"
+#include "selfsense/importers/import_columns.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -8,10 +8,10 @@
 #include <system_error>
 #include <utility>
 
-#include "import_text.hpp"
 #include "selfsense/base/format_number.hpp"
+#include "selfsense/importers/import_text.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::importers {
 namespace {
 
 using base::format_number;
@@ -157,4 +157,4 @@ io::Recording import_columns(const std::filesystem::path& path, const ColumnsOpt
   return rec;
 }
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::importers

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-namespace selfsense::cli {
+namespace selfsense::importers {
 
 // The file's lines without their line ends ("\n" or "\r\n"); line k (1-based) is lines[k - 1].
 // Throws io::RecordingError naming the file if it cannot be read or is empty.
@@ -30,4 +30,4 @@ namespace selfsense::cli {
 // The units unit_factor knows, for messages.
 [[nodiscard]] std::string known_units();
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::importers
