@@ -92,8 +92,10 @@ struct Reidentified {
 // channel may forecast worse (the structure replaces both sides). The improved model is that
 // structure identified on the whole record. Nothing is judged where the stress does not move
 // apart from the field (a constant preload: what a fit on E and the base's outputs leaves of T is
-// below 1e-9 of its magnitude). diagnose() calls it only where its first pass named nothing or
-// nothing but stress, and takes it only where it names a channel that pass did not.
+// below 1e-9 of its magnitude), and nothing is returned where the structure identified on the
+// whole record fits a channel worse than the given model (a named one: by min_explains better).
+// diagnose() calls it only where its first pass named nothing or nothing but stress, and takes
+// it only where it names a channel that pass did not.
 struct StressReidentified {
   models::TransducerModel model{};  // stress-hysteresis, identified on the whole record
   Outputs outputs{};                // its D and S over the record
