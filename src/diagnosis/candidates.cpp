@@ -183,7 +183,23 @@ void describe_stress(Finding& f, const Evidence& e) {
   const std::string& n = e.ch.name;
   const std::string& tail = e.tail;
   const double pct = e.pct;
-  if (c.stress_quadratic_per_pa2 != 0.0) {
+  if (c.stress_drive_per_pa != 0.0) {
+    // Each part of the sensed response with its own change per MPa, at the recording's mean
+    // drive magnitude: the permittivity's (T x), the whole response's (T r), the coupling's (T^2).
+    double x_rms = 0.0;
+    for (const double x : s.drive)
+      x_rms += x * x / static_cast<double>(s.drive.size());
+    x_rms = std::sqrt(x_rms);
+    f.evidence = "the recorded " + n +
+                 format(
+                     " follows the stress in each part of its response: the field's linear "
+                     "part changes by %.3g %% of range per MPa at the RMS field, the whole "
+                     "response by %.3g %% per MPa, and the coupling bends with T^2 (%.3g %% of "
+                     "range at 1 MPa)",
+                     c.stress_drive_per_pa * 1e6 * x_rms * pct, 100.0 * c.stress_gain_per_pa * 1e6,
+                     c.stress_quadratic_per_pa2 * 1e12 * pct) +
+                 tail;
+  } else if (c.stress_quadratic_per_pa2 != 0.0) {
     const double t = std::max(std::abs(*std::max_element(s.stress.begin(), s.stress.end())),
                               std::abs(*std::min_element(s.stress.begin(), s.stress.end())));
     f.evidence = "the recorded " + n +
@@ -327,6 +343,16 @@ const std::vector<Candidate>& candidates() {
        false,
        Needs::kStress,
        &describe_stress},
+      // ... and on the sensed channel each part of the response apart: the permittivity (T x),
+      // the loop with it (T r) and the coupling (T^2), all linear in T given the drive, so the
+      // reconstruction solves them with the sensor coupling (models/channel_correction.hpp).
+      {"stress_dependence",
+       {CorrectionTerm::kStress, CorrectionTerm::kStressDrive, CorrectionTerm::kStressQuadratic,
+        CorrectionTerm::kOffset},
+       true,
+       false,
+       Needs::kStress,
+       &describe_stress},
       {"permittivity_nonlinearity",
        {CorrectionTerm::kDrivePolynomial},
        true,
@@ -359,7 +385,10 @@ bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, boo
   if (ch.sensed ? !c.on_sensed : !c.on_strain) return false;
   const auto uses = [&](CorrectionTerm t) { return uses_term(c, t); };
   // T^2 on the sensed channel is solved with the sensor coupling; leakage is a charge's.
-  if (uses(CorrectionTerm::kStressQuadratic) && ch.coupling == 0.0) return false;
+  if ((uses(CorrectionTerm::kStressQuadratic) || uses(CorrectionTerm::kStressDrive)) && ch.sensed &&
+      ch.coupling == 0.0) {
+    return false;
+  }
   if ((uses(CorrectionTerm::kLeakage) || uses(CorrectionTerm::kDriveIntegral)) && charge_drive) {
     return false;
   }
@@ -450,6 +479,7 @@ std::size_t complexity(const std::vector<CorrectionTerm>& terms) {
     switch (t) {
       case CorrectionTerm::kOffset:
       case CorrectionTerm::kDrivePolynomial:
+      case CorrectionTerm::kStressDrive:
       case CorrectionTerm::kDynamics:
         n += 2;
         break;

@@ -160,6 +160,10 @@ Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm>
           return stress * stress;
         });
         break;
+      case CorrectionTerm::kStressDrive:
+        add([&](std::size_t k) { return at(s.stress, k, 0.0) * s.drive[k]; });
+        add([&](std::size_t k) { return at(s.stress, k, 0.0); });
+        break;
       case CorrectionTerm::kDrivePolynomial:
         add([&](std::size_t k) { return s.drive[k] * s.drive[k]; });
         add([&](std::size_t k) { return s.drive[k] * s.drive[k] * s.drive[k]; });
@@ -251,6 +255,10 @@ void apply_coefficients(std::span<const CorrectionTerm> terms, const Columns& co
         break;
       case CorrectionTerm::kStressQuadratic:
         out.stress_quadratic_per_pa2 = c[i++];
+        break;
+      case CorrectionTerm::kStressDrive:
+        out.stress_drive_per_pa = c[i++];
+        out.stress_linear_per_pa = c[i++];
         break;
       case CorrectionTerm::kDrivePolynomial:
         out.drive_quadratic = c[i++];

@@ -131,7 +131,7 @@ std::optional<InputRange> read_range(YamlMap& map, std::string_view key) {
 // The scalar keys of a correction (channel_correction.hpp), shared by reading and writing.
 template <typename C>
 auto correction_scalars(C& c) {
-  return std::array<std::pair<const char*, decltype(&c.gain)>, 22>{{
+  return std::array<std::pair<const char*, decltype(&c.gain)>, 24>{{
       {"gain", &c.gain},
       {"offset", &c.offset},
       {"temperature_reference_degc", &c.temperature_reference_degc},
@@ -146,6 +146,8 @@ auto correction_scalars(C& c) {
       {"drive_integral_per_s", &c.drive_integral_per_s},
       {"stress_gain_per_pa", &c.stress_gain_per_pa},
       {"stress_quadratic_per_pa2", &c.stress_quadratic_per_pa2},
+      {"stress_drive_per_pa", &c.stress_drive_per_pa},
+      {"stress_linear_per_pa", &c.stress_linear_per_pa},
       {"drive_quadratic", &c.drive_quadratic},
       {"drive_cubic", &c.drive_cubic},
       {"drive_linear", &c.drive_linear},

@@ -31,6 +31,8 @@ bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) co
       {"drive_integral_per_s", drive_integral_per_s},
       {"stress_gain_per_pa", stress_gain_per_pa},
       {"stress_quadratic_per_pa2", stress_quadratic_per_pa2},
+      {"stress_drive_per_pa", stress_drive_per_pa},
+      {"stress_linear_per_pa", stress_linear_per_pa},
       {"drive_quadratic", drive_quadratic},
       {"drive_cubic", drive_cubic},
       {"drive_linear", drive_linear},
@@ -129,11 +131,6 @@ bool ChannelCorrection::plays_valid(const std::string& prefix, std::string* why)
 }
 
 bool ChannelCorrection::invertible(const std::string& prefix, std::string* why) const {
-  if (stress_gain_per_pa != 0.0) {
-    return fail(why, prefix +
-                         ".stress_gain_per_pa: the sensed channel then depends on T "
-                         "nonlinearly; reconstruction has no closed-form inverse");
-  }
   if (dynamics_frequency_hz != 0.0) {
     return fail(why, prefix +
                          ".dynamics_frequency_hz: dynamics on the sensed channel are not "
@@ -152,7 +149,8 @@ bool ChannelCorrection::empty() const noexcept {
          temperature_drive_per_k2 == 0.0 && temperature_stress_per_k == 0.0 &&
          temperature_stress_per_k2 == 0.0 && drive_integral_per_s == 0.0 &&
          drive_creep_weights.empty() && stress_gain_per_pa == 0.0 &&
-         stress_quadratic_per_pa2 == 0.0 && drive_quadratic == 0.0 && drive_cubic == 0.0 &&
+         stress_quadratic_per_pa2 == 0.0 && stress_drive_per_pa == 0.0 &&
+         stress_linear_per_pa == 0.0 && drive_quadratic == 0.0 && drive_cubic == 0.0 &&
          drive_linear == 0.0 && sensed_quadratic == 0.0 && creep_weights.empty() &&
          dynamics_frequency_hz == 0.0 && leakage_tau_s == 0.0 && delay_s == 0.0 &&
          hysteresis_weights.empty() && hinge_weights.empty();
@@ -237,7 +235,9 @@ double CorrectionStage::terms(const Inputs& in) const noexcept {
 
 double CorrectionStage::stress_coupling_change(const Inputs& in) const noexcept {
   const double dtheta = in.temperature - c_.temperature_reference_degc;
-  return (c_.temperature_stress_per_k + c_.temperature_stress_per_k2 * dtheta) * dtheta;
+  return c_.stress_gain_per_pa * in.response + c_.stress_drive_per_pa * in.drive +
+         c_.stress_linear_per_pa +
+         (c_.temperature_stress_per_k + c_.temperature_stress_per_k2 * dtheta) * dtheta;
 }
 
 // Writes `value` into a ring and reads it back the configured delay later (linear interpolation
@@ -319,7 +319,7 @@ double CorrectionStage::step(const Inputs& in) noexcept {
     for (std::size_t j = 0; j < creep_count_; ++j)
       z_[j] = in.response;
   }
-  double v = in.y * gain_at(in) + c_.stress_gain_per_pa * in.stress * in.response +
+  double v = in.y * gain_at(in) +
              (c_.stress_quadratic_per_pa2 * in.stress + stress_coupling_change(in)) * in.stress +
              terms(in) + play_terms(in.drive) + drive_memory_terms(in.drive, 0.0);
   for (std::size_t j = 0; j < creep_count_; ++j) {

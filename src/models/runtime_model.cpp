@@ -271,17 +271,30 @@ Reconstruction::Reconstruction(const TransducerModel& model, const RuntimeOption
   if (model.sensed_correction && !model.sensed_correction->invertible("corrections.sensed", &why)) {
     throw std::invalid_argument(why);
   }
-  if (model.sensed_correction && !model.sensed_correction->creep_weights.empty() &&
-      model.vectorial) {
-    throw std::invalid_argument(
-        "corrections.sensed.creep_weights: creep of the sensed channel follows the sensor's "
-        "response to the drive alone, which the stress-hysteresis model does not separate");
+  if (model.sensed_correction && model.vectorial) {
+    const auto& c = *model.sensed_correction;
+    const char* key = !c.creep_weights.empty()      ? "creep_weights"
+                      : c.stress_gain_per_pa != 0.0 ? "stress_gain_per_pa"
+                                                    : nullptr;
+    if (key != nullptr) {
+      throw std::invalid_argument(
+          std::string("corrections.sensed.") + key +
+          ": follows the sensor's response to the drive alone, which the stress-hysteresis "
+          "model does not separate");
+    }
   }
-  if (model.sensed_correction && model.sensed_correction->stress_quadratic_per_pa2 != 0.0 &&
-      sensed_coupling_ == 0.0) {
-    throw std::invalid_argument(
-        "corrections.sensed.stress_quadratic_per_pa2: needs a sensor side with a stress coupling "
-        "to be solved in the reconstruction");
+  if (model.sensed_correction && sensed_coupling_ == 0.0) {
+    const auto& c = *model.sensed_correction;
+    const char* key = c.stress_quadratic_per_pa2 != 0.0 ? "stress_quadratic_per_pa2"
+                      : c.stress_drive_per_pa != 0.0    ? "stress_drive_per_pa"
+                      : c.stress_linear_per_pa != 0.0   ? "stress_linear_per_pa"
+                      : c.stress_gain_per_pa != 0.0     ? "stress_gain_per_pa"
+                                                        : nullptr;
+    if (key != nullptr) {
+      throw std::invalid_argument(std::string("corrections.sensed.") + key +
+                                  ": needs a sensor side with a stress coupling to be solved in "
+                                  "the reconstruction");
+    }
   }
   identity_ = {model.structure, parameter_hash(model),
                kernel_size(impl_) + stages_size(sensed_fix_, strain_fix_)};
@@ -320,7 +333,7 @@ Reconstruction::Estimate Reconstruction::kernel_step(double drive, double sensed
   }
   if (sensed_fix_ && sensed_coupling_ != 0.0) {
     const double stress = sensed_fix_->solve_stress(out.stress, sensed_coupling_,
-                                                    {0.0, x, 0.0, temperature_, 0.0, 0.0});
+                                                    {0.0, x, 0.0, temperature_, 0.0, response});
     out.strain += strain_coupling_ * (stress - out.stress);
     out.stress = stress;
   }

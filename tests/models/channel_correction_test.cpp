@@ -47,6 +47,10 @@ ChannelCorrection sensed_correction() {
   c.drive_integral_per_s = 3e-9;            // a parallel conductance's current [S/m]
   c.drive_creep_eigenvalues = {50.0, 2.0};  // creep driven by the input
   c.drive_creep_weights = {1e-10, 2e-10};
+  c.stress_gain_per_pa = 2e-9;         // stress dependence of each part of the response
+  c.stress_drive_per_pa = 7e-17;       // [C/m^2 / (V/m Pa)]
+  c.stress_linear_per_pa = 1e-13;      // [C/m^2 / Pa]
+  c.stress_quadratic_per_pa2 = 1e-20;  // [C/m^2 / Pa^2]
   return c;
 }
 
@@ -252,6 +256,41 @@ TEST(ChannelCorrection, StressQuadraticIsSolvedInTheReconstruction) {
   }
   EXPECT_LT(worst, 1e-6 * range);
   EXPECT_GT(worst_ignorant, 100.0 * worst);  // the term matters: without it T_hat is off
+}
+
+// Stress dependence of each part of D: D = h + d T + (k_r r + k_x x + k_1) T + q T^2 with r the
+// response to the field alone (loop and permittivity), x the field (the permittivity alone) and
+// k_1 a coupling change: linear in T given the field, so the reconstruction solves it after the
+// kernel and recovers T; without the terms T_hat is off.
+TEST(ChannelCorrection, StressTermsOfTheSensedChannelAreSolvedInTheReconstruction) {
+  TransducerModel m = test::typical_transducer(kTs);
+  const double d = m.sensor->linear_gains.front();
+  ChannelCorrection c;
+  c.stress_gain_per_pa = 5e-9;            // the response +0.5 % per MPa
+  c.stress_drive_per_pa = 4e-9 * 1.8e-8;  // a permittivity of 1.8e-8 F/m, +0.4 % per MPa
+  c.stress_linear_per_pa = 3e-3 * d;      // the coupling +0.3 %
+  c.stress_quadratic_per_pa2 = 4e-9 * d;  // ... and bending with T
+  m.sensed_correction = c;
+  std::string why;
+  ASSERT_TRUE(c.invertible("corrections.sensed", &why)) << why;
+  const test::TransducerData data = test::transducer_data(m, 3000, kTs, 8);
+  Simulation sim(m);
+  Reconstruction rec(m);
+  TransducerModel plain = m;
+  plain.sensed_correction.reset();
+  Reconstruction ignorant(plain);
+  double worst = 0.0;
+  double worst_ignorant = 0.0;
+  double range = 0.0;
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    const double dk = sim.step(data.e[k], data.t[k]).sensed;
+    worst = std::max(worst, std::abs(rec.step(data.e[k], dk).stress - data.t[k]));
+    worst_ignorant =
+        std::max(worst_ignorant, std::abs(ignorant.step(data.e[k], dk).stress - data.t[k]));
+    range = std::max(range, std::abs(data.t[k]));
+  }
+  EXPECT_LT(worst, 1e-6 * range);
+  EXPECT_GT(worst_ignorant, 100.0 * worst);
 }
 
 // A coupling that moves with the temperature, (d + k1 dtheta + k2 dtheta^2) T on D: the

@@ -285,6 +285,40 @@ TEST(RuntimeModel, HotSwapCarriesMatchingPlaysAndReinitialisesTheRest) {
     EXPECT_EQ(a.values[i], b.values[i]) << "play " << i;
 }
 
+// A term that follows the sensor's response to the drive alone (stress_gain T r, creep) needs
+// that response, which a stress-hysteresis model does not separate, and the terms in T are solved
+// with an affine sensor coupling it does not have: each refused by name.
+TEST(RuntimeModel, StressHysteresisRefusesSensedStressTerms) {
+  const TransducerModel truth = test::typical_transducer(kTs);
+  const test::TransducerData d = test::transducer_data(truth, 5000, 0.0, 10);
+  TransducerModel m;
+  m.structure = Structure::kStressHysteresis;
+  m.sample_time = kTs;
+  m.vectorial = identification::fit_stress_hysteresis(d.e, d.t, d.d, d.s, kTs, 12);
+  ChannelCorrection c;
+  c.stress_gain_per_pa = 1e-9;
+  m.sensed_correction = c;
+  try {
+    Reconstruction r(m);
+    FAIL() << "stress_gain on a stress-hysteresis model's sensed channel was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("corrections.sensed.stress_gain_per_pa"),
+              std::string::npos)
+        << e.what();
+  }
+  c.stress_gain_per_pa = 0.0;
+  c.stress_drive_per_pa = 1e-17;
+  m.sensed_correction = c;
+  try {
+    Reconstruction r(m);
+    FAIL() << "stress_drive on a stress-hysteresis model's sensed channel was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("corrections.sensed.stress_drive_per_pa"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(RuntimeModel, StressHysteresisRunsThroughTheSameType) {
   const TransducerModel truth = test::typical_transducer(kTs);
   const test::TransducerData d = test::transducer_data(truth, 20000, 0.0, 10);

@@ -25,6 +25,8 @@ enum class CorrectionTerm : std::uint8_t {
   kTemperatureQuadratic,  // the same per kelvin squared
   kStress,                // gain per pascal (of the drive response)
   kStressQuadratic,       // T^2: a stress-dependent coupling seen on the sensed channel
+  kStressDrive,           // T x and T: a permittivity (the drive's linear response) and a
+                          // coupling that move with T
   kDrivePolynomial,
   kSensedQuadratic,
   kCreep,                 // log-spaced lags of y

@@ -12,6 +12,8 @@
 //         + temperature_drive2 (theta - theta_ref)^2 x
 //         + temperature_stress2 (theta - theta_ref)^2 T
 //         + stress_gain T r + stress_quadratic T^2               stress_dependence
+//         + stress_drive T x + stress_linear T                   (the permittivity, the
+//                                                                coupling moving with stress)
 //         + drive_quadratic x^2 + drive_cubic x^3                permittivity_nonlinearity
 //         + sensed_quadratic s^2                                 electrostriction (S ~ P^2,
 //                                                                P ~ D - d T)
@@ -39,7 +41,9 @@
 // sensed response to the drive alone (D - d T, d the sensor's coupling), r = y - coupling T the
 // channel's response to the drive alone (so a coupling that changes with stress,
 // d(T) = d (1 + k T), is k T r on S and d k T^2 on D). Units: gain, temperature_gain [1/K],
-// stress_gain [1/Pa] relative, temperature_gain2 [1/K^2]; offset, drive_linear and the
+// stress_gain [1/Pa] relative, stress_drive [channel unit / (drive unit Pa)], stress_linear
+// [channel unit / Pa], temperature_gain2
+// [1/K^2]; offset, drive_linear and the
 // polynomial terms in the channel's unit (per unit of the drive to its power); temperature_stress
 // [channel unit / (Pa K)], temperature_stress2 [channel unit / (Pa K^2)]; drive_integral in
 // the channel's unit per (drive unit s): for D under field drive the conductivity [S/m].
@@ -50,13 +54,13 @@
 // on the drive alone; the integral of the delayed drive starts at -delay x0, so that it is the
 // forward integral a delay later; the creep lags
 // follow the response r = y - d T, which for the affine models is G_s[x] + y0_s, known from the
-// drive before y: the caller passes it) are solved for y; stress_quadratic and the temperature's
-// stress terms are solved with the sensor coupling d after the kernel:
-// (d + k') T + q' T^2 = d T_lin (q' = q / g, k' = (temperature_stress + temperature_stress2
-// (theta - theta_ref)) (theta - theta_ref) / g, g = 1 + gain terms). Terms
-// that depend on T or on y's own history (stress_gain, dynamics) make the sensor side
-// non-invertible in closed form: invertible() says so and the Reconstruction refuses such a
-// model by name.
+// drive before y: the caller passes it) are solved for y; the terms in T are solved with the
+// sensor coupling d after the kernel: (d + k') T + q' T^2 = d T_lin, with q' = q / g,
+//   k' = (stress_gain r + stress_drive x + stress_linear
+//         + (temperature_stress + temperature_stress2 dtheta) dtheta) / g,
+// dtheta = theta - theta_ref, g = 1 + gain terms, r again the response to the drive alone. Terms
+// that depend on y's own history (dynamics) make the sensor side non-invertible in closed form:
+// invertible() says so and the Reconstruction refuses such a model by name.
 //
 // Real-time safe after construction: step(), filter(), invert(), save/restore are noexcept and
 // allocate nothing.
@@ -87,6 +91,8 @@ struct ChannelCorrection {
   double drive_integral_per_s{0.0};
   double stress_gain_per_pa{0.0};
   double stress_quadratic_per_pa2{0.0};
+  double stress_drive_per_pa{0.0};   // [channel unit / (drive unit Pa)]
+  double stress_linear_per_pa{0.0};  // [channel unit / Pa]
   double drive_quadratic{0.0};
   double drive_cubic{0.0};
   double drive_linear{0.0};  // the PI operator's linear play (hysteresis)
@@ -145,15 +151,18 @@ class CorrectionStage {
   // already be delayed by the caller (delay_samples()) and, with creep terms, `in.response` is
   // the sensor's response to that drive alone.
   double invert(double measured, const Inputs& in) noexcept;
-  // After the kernel: the stress that solves the stress_quadratic and temperature-stress terms,
-  // from the kernel's T_lin and the sensor coupling d (T_lin itself without them).
+  // After the kernel: the stress that solves the terms in T (stress_gain, stress_quadratic,
+  // stress_drive, temperature-stress), from the kernel's T_lin and the sensor coupling d (T_lin
+  // itself without them); with stress_gain, `in.response` is the response to the drive alone.
   [[nodiscard]] double solve_stress(double t_lin, double coupling, const Inputs& in) const noexcept;
   // The drive delayed by this channel's delay (reconstruction feeds it to the kernel).
   double delay_drive(double drive) noexcept;
 
   [[nodiscard]] const ChannelCorrection& correction() const noexcept { return c_; }
-  // The inverse reads Inputs::response (creep terms).
-  [[nodiscard]] bool reads_response() const noexcept { return creep_count_ > 0; }
+  // The inverse reads Inputs::response (creep terms, stress_gain).
+  [[nodiscard]] bool reads_response() const noexcept {
+    return creep_count_ > 0 || c_.stress_gain_per_pa != 0.0;
+  }
   [[nodiscard]] static constexpr std::size_t state_size() noexcept { return kStateSize; }
   void save_state(std::span<double> out) const noexcept;
   void restore_state(std::span<const double> in) noexcept;
@@ -164,7 +173,8 @@ class CorrectionStage {
       15 + 2 * kMaxCorrectionCreep + kMaxCorrectionPlays + 2 * kLine;
 
   double terms(const Inputs& in) const noexcept;  // the additive/gain terms except creep and T
-  // (temperature_stress + temperature_stress2 dtheta) dtheta: the change of the stress coupling.
+  // stress_gain r + stress_drive x + stress_linear + (temperature_stress + temperature_stress2
+  // dtheta) dtheta: the change of the stress coupling.
   double stress_coupling_change(const Inputs& in) const noexcept;
   double gain_at(const Inputs& in) const noexcept;
   double filters(double v) noexcept;         // dynamics, leakage, delay
