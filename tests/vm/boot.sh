@@ -33,7 +33,7 @@ vm_previous_package() {
 out=$1
 shift
 vm_require_image
-args=(--timeout 420)
+args=(--timeout 540)
 while [ $# -gt 0 ]; do
   if [ "$1" = --file ]; then
     args+=(--file "${2:?--file needs a path}")
