@@ -1,7 +1,7 @@
 # The Debian packages, built with CPack's DEB generator (`cpack --config build/CPackConfig.cmake`,
 # or `scripts/setup.sh package`): `selfsense` (the programs, the systemd unit, the system user,
 # the devices' group, the configurations in /etc/selfsense, the simulated transducer under
-# /usr/share/selfsense) and `libselfsense-dev` (headers, static libraries, CMake package).
+# /usr/share/selfsense, the man pages) and `libselfsense-dev` (headers, static libraries, CMake package).
 # The system files are installed with absolute paths and EXCLUDE_FROM_ALL: into the package,
 # never by a plain `cmake --install`.
 set(_pkg ${PROJECT_BINARY_DIR}/packaging)
@@ -74,6 +74,16 @@ foreach(_name selfsense libselfsense-dev)
   endif()
 endforeach()
 
+# The man pages (man/, hand-written; tests/package/check_man.sh keeps them in step with --help),
+# compressed as Debian installs them.
+foreach(_page selfsense.1 selfsensed.8)
+  file(COPY ${PROJECT_SOURCE_DIR}/man/${_page} DESTINATION ${_pkg}/man)
+  execute_process(COMMAND gzip -9nf ${_pkg}/man/${_page} RESULT_VARIABLE _gzip_rc)
+  if(NOT _gzip_rc EQUAL 0)
+    message(FATAL_ERROR "gzip of ${_pkg}/man/${_page} failed")
+  endif()
+endforeach()
+
 # Conffiles: every file under /etc/selfsense.
 set(_conffiles "/etc/selfsense/selfsensed.yaml\n")
 foreach(_example IN LISTS _examples)
@@ -88,7 +98,8 @@ endforeach()
 set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS
   ${PROJECT_SOURCE_DIR}/systemd/selfsensed.service
   ${PROJECT_SOURCE_DIR}/packaging/debian/postinst ${PROJECT_SOURCE_DIR}/packaging/debian/prerm
-  ${PROJECT_SOURCE_DIR}/packaging/debian/postrm ${PROJECT_SOURCE_DIR}/config/selfsensed.yaml)
+  ${PROJECT_SOURCE_DIR}/packaging/debian/postrm ${PROJECT_SOURCE_DIR}/config/selfsensed.yaml
+  ${PROJECT_SOURCE_DIR}/man/selfsense.1 ${PROJECT_SOURCE_DIR}/man/selfsensed.8)
 
 set(_system COMPONENT runtime EXCLUDE_FROM_ALL)
 install(FILES ${_pkg}/selfsensed.service DESTINATION /lib/systemd/system ${_system})
@@ -101,6 +112,8 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/models/ DESTINATION ${_share}/mod
   FILES_MATCHING PATTERN "*.yaml")
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/plant/ DESTINATION ${_share}/plant ${_system}
   FILES_MATCHING PATTERN "*.yaml")
+install(FILES ${_pkg}/man/selfsense.1.gz DESTINATION /usr/share/man/man1 ${_system})
+install(FILES ${_pkg}/man/selfsensed.8.gz DESTINATION /usr/share/man/man8 ${_system})
 install(FILES ${_pkg}/doc/selfsense/changelog.gz ${PROJECT_SOURCE_DIR}/packaging/debian/copyright
   DESTINATION /usr/share/doc/selfsense ${_system})
 install(FILES ${_pkg}/doc/libselfsense-dev/changelog.gz ${PROJECT_SOURCE_DIR}/packaging/debian/copyright

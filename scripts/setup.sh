@@ -4,8 +4,9 @@
 # (`package`). Idempotent and non-interactive; run as root on a fresh machine (apt-get), as any
 # user once installed.
 #
-#   scripts/setup.sh demo   install, build (Release), run the main job (the daemon on the
-#                           simulated transducer; before it the operator demo and self-sensing)
+#   scripts/setup.sh demo   install what the programs need, build selfsense and selfsensed only
+#                           (Release, no tests), run the main job (the daemon on the simulated
+#                           transducer; before it the operator demo and self-sensing)
 #   scripts/setup.sh test   install, format check, build (Release, -Werror), unit tests,
 #                           clang-tidy, then build (clang) and test again under ASan + UBSan
 #                           and run every fuzz target for a bounded time; the Debian packages
@@ -26,18 +27,28 @@ jobs=$(nproc)
 cd "$root"
 
 say() { printf '\n== %s\n' "$*"; }
+setup_begin=$SECONDS
+demo_build=${SELFSENSE_DEMO_BUILD:-build}
 
+# What the programs need to build (the demo's whole list): compiler, CMake, the libraries.
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libyaml-cpp-dev libgpiod-dev libmodbus-dev libsystemd-dev libcli11-dev
   nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
-  clang-format clang-tidy python3  # python3: run-clang-tidy and scripts/tidy_cached.py
-  clang libclang-rt-14-dev  # the sanitizer build and the fuzz targets (libFuzzer), tests/fuzz
-  zlib1g-dev chromium fonts-liberation  # the reports' browser tests (tests/cli)
-  mbpoll
-  rt-tests  # cyclictest beside the loop in tests/bench/loop_timing_bench (docs/benchmarks.md)
 )
+# The checks: the tests, lint, sanitizers and fuzzing, the browser that renders the reports in
+# their tests. The demo builds only the two programs it runs and draws its page itself
+# (`selfsense main-job-page`): none of these.
+if [ "$mode" != demo ]; then
+  packages+=(
+    libgtest-dev libgmock-dev libbenchmark-dev
+    clang-format clang-tidy python3  # python3: run-clang-tidy and scripts/tidy_cached.py
+    clang libclang-rt-14-dev  # the sanitizer build and the fuzz targets (libFuzzer), tests/fuzz
+    zlib1g-dev chromium fonts-liberation  # the reports' browser tests (tests/cli)
+    mbpoll
+    rt-tests  # cyclictest beside the loop in tests/bench/loop_timing_bench (docs/benchmarks.md)
+  )
+fi
 # The Debian packages (cmake/SelfsensePackage.cmake, tests/package): dpkg-shlibdeps (dpkg-dev)
 # computes Depends, lintian reads them back. Not for the demo.
 if [ "$mode" = package ] || [ "$mode" = test ] || [ "$mode" = port ]; then
@@ -168,7 +179,7 @@ run_tests() {
 # minor loops of many sizes and offsets) and a validation recording under excitation the fit
 # never saw, identify the Preisach-class model, reconstruct T and S from E and D alone.
 run_self_sensing() {
-  local out=build/demo cli=build/src/cli/selfsense cfg=config/plant/reconstruction.yaml
+  local out=$demo_build/demo cli=$demo_build/src/cli/selfsense cfg=config/plant/reconstruction.yaml
   mkdir -p "$out"
   say "main job: plant recordings ($cfg, config/plant/reconstruction-validation.yaml)"
   "$cli" plant --config "$cfg" --excitation identification --seed 1 --out "$out/identification.csv"
@@ -271,16 +282,24 @@ for arch in "${cross_arches[@]}"; do
 done
 case "$mode" in
   demo)
-    configure_and_build build -DCMAKE_BUILD_TYPE=Release
+    # The two programs the demo runs, nothing else: no test, no benchmark (SELFSENSE_DEMO_BUILD:
+    # another build directory, e.g. to time a fresh build beside build/).
+    say "build: $demo_build (Release): selfsense and selfsensed"
+    cmake -S . -B "$demo_build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSELFSENSE_BUILD_TESTS=OFF \
+      -DSELFSENSE_BUILD_BENCHMARKS=OFF
+    cmake --build "$demo_build" -j "$jobs" --target selfsense selfsensed
     say "main job: selfsense demo"
-    build/src/cli/selfsense demo
+    "$demo_build/src/cli/selfsense" demo
     run_self_sensing
     say "main job: selfsensed on config/sim.yaml, driven through selfsense ctl"
-    bash scripts/main_job.sh build build/main-job
+    bash scripts/main_job.sh "$demo_build" "$demo_build/main-job"
+    say "demo: done in $((SECONDS - setup_begin)) s; the page: $demo_build/main-job/main_job.html"
     ;;
   test)
     check_format
-    configure_and_build build -DCMAKE_BUILD_TYPE=Release -DSELFSENSE_WERROR=ON
+    # Tests and benchmarks on: a build directory the demo configured has them off.
+    configure_and_build build -DCMAKE_BUILD_TYPE=Release -DSELFSENSE_WERROR=ON \
+      -DSELFSENSE_BUILD_TESTS=ON -DSELFSENSE_BUILD_BENCHMARKS=ON
     run_tests build -LE vm
     run_vm_tests build
     check_tidy

@@ -72,7 +72,8 @@ require "$work/runtime.list" /usr/bin/selfsensed /usr/bin/selfsense \
   /lib/udev/rules.d/60-selfsense.rules /etc/selfsense/selfsensed.yaml \
   /usr/share/selfsense/models/sim.yaml /usr/share/selfsense/plant/daemon.yaml \
   /usr/share/selfsense/plant/damping.yaml \
-  /usr/share/doc/selfsense/copyright /usr/share/doc/selfsense/changelog.gz
+  /usr/share/doc/selfsense/copyright /usr/share/doc/selfsense/changelog.gz \
+  /usr/share/man/man1/selfsense.1.gz /usr/share/man/man8/selfsensed.8.gz
 for example in "${examples[@]}"; do
   require "$work/runtime.list" "/etc/selfsense/examples/$example.yaml"
 done

@@ -3,26 +3,46 @@
 # the VM itself did not report (timeout, panic, no payload); each test's own result is checked
 # by its CTest test (systemd_smoke.sh, can_smoke.sh, ...), so one failure does not hide the
 # others. The PROGRAMs (host-built, e.g. the selfsense tool) go in with their libraries;
-# --packages BUILD_DIR: the build's Debian packages (tests/package/packages_dir.sh) as
-# /payload/files/packages/.
+# --packages BUILD_DIR: the build's selfsense package (tests/package/packages_dir.sh) as
+# /payload/files/packages/, and the same as a lower version in /payload/files/packages/previous/
+# (the upgrade's starting point).
 #   tests/vm/boot.sh OUT_DIR [PROGRAM... | --file PATH... | --packages BUILD_DIR]
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
+# vm_previous_package BUILT DIR: DIR/ holds this build's selfsense package and the same package
+# as a lower version (VERSION~prev, repacked with dpkg-deb), the one the VM upgrades from.
+vm_previous_package() {
+  local built=$1 dir=$2 deb version previous
+  rm -rf "$dir" "$dir.tree"
+  mkdir -p "$dir"
+  deb=$(ls "$built"/selfsense_*_"$(dpkg --print-architecture)".deb) || return 1
+  cp "$deb" "$dir/"
+  version=$(dpkg-deb -f "$deb" Version)
+  previous="$version~prev"
+  dpkg --compare-versions "$previous" lt "$version" || return 1
+  dpkg-deb -R "$deb" "$dir.tree"
+  sed -i "s/^Version: .*/Version: $previous/" "$dir.tree/DEBIAN/control"
+  mkdir -p "$dir/previous"
+  dpkg-deb --root-owner-group -b "$dir.tree" "$dir/previous/selfsense_${previous}_$(dpkg --print-architecture).deb" >/dev/null
+  rm -rf "$dir.tree"
+}
+
 [ $# -ge 1 ] || { echo "usage: tests/vm/boot.sh OUT_DIR [PROGRAM...]" >&2; exit 2; }
 out=$1
 shift
 vm_require_image
-args=(--timeout 420)
+args=(--timeout 540)
 while [ $# -gt 0 ]; do
   if [ "$1" = --file ]; then
     args+=(--file "${2:?--file needs a path}")
     shift 2
   elif [ "$1" = --packages ]; then
-    packages=$(bash "$vm_repo/tests/package/packages_dir.sh" "${2:?--packages needs a build directory}" \
-      "$out-packages") || { echo "FAIL: no packages to install in the VM"; exit 1; }
-    args+=(--file "$packages")
+    built=$(bash "$vm_repo/tests/package/packages_dir.sh" "${2:?--packages needs a build directory}" \
+      "$out-cpack") || { echo "FAIL: no packages to install in the VM"; exit 1; }
+    vm_previous_package "$built" "$out-vm/packages" || { echo "FAIL: no previous package for the upgrade"; exit 1; }
+    args+=(--file "$out-vm/packages")
     shift 2
   else
     args+=(--program "$1")

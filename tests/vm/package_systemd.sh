@@ -1,12 +1,20 @@
 #!/usr/bin/env bash
 # Host side of payload/package_systemd.sh: the selfsense Debian package installed with apt in the
-# VM, enabled and run by systemd, armed through the installed tool, stopped, removed, purged.
+# VM (the previous version first, its configuration changed, then upgraded: the change kept, the
+# service restarted), enabled and run by systemd, armed through the installed tool, stopped,
+# removed, purged.
 #   tests/vm/package_systemd.sh OUT_DIR   (after tests/vm/boot.sh OUT_DIR ... --packages BUILD)
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
 vm_check_test "${1:?usage: tests/vm/package_systemd.sh OUT_DIR}" package_systemd \
+  'previous=[^ ]*~prev install ok installed' \
+  'is-active_before_upgrade=active' \
+  'upgraded=yes' \
+  'config_after_upgrade=kept' \
+  'is-active_after_upgrade=active' \
+  'restarted_by_upgrade=yes' \
   'installed=install ok installed' \
   'unit_path=/lib/systemd/system/selfsensed.service' \
   'user=selfsense,dialout' \
