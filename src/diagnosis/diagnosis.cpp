@@ -191,7 +191,7 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
         models::TransducerModel with_creep = model;
         with_creep.structure = *creep->structure;
         std::optional<Reidentified> beside =
-            reidentified_leak(with_creep, s, ch, model_output, options);
+            reidentified_leak(with_creep, s, ch, model_output, options, ShownBy::kForecast);
         if (beside) search_again(*beside, {creep_found});
       }
     } else if (leak) {

@@ -197,9 +197,11 @@ namespace {
 // fit) and beat the null on the second half by the rules of a round. The share of the null's
 // error it removes there, or nullopt.
 std::optional<double> forecast_explains(const Trial& null, const Trial& best, const ChannelData& ch,
-                                        std::size_t half, const Options& options) {
+                                        std::size_t half, const Options& options,
+                                        ShownBy evidence) {
   if (null.forecast.empty() || best.forecast.empty() ||
-      1.0 - best.first_half_sse / null.first_half_sse < options.min_explains) {
+      (evidence == ShownBy::kFitAndForecast &&
+       1.0 - best.first_half_sse / null.first_half_sse < options.min_explains)) {
     return std::nullopt;
   }
   const Rows rows =
@@ -241,7 +243,8 @@ std::optional<Reidentified> identified_whole(const Judge& judge,
 template <typename Refine>
 std::optional<Reidentified> judged_as_forecast(const Judge& judge, const ChannelData& ch,
                                                const std::vector<models::ChannelCorrection>& grid,
-                                               Refine&& refine, const Options& options) {
+                                               Refine&& refine, const Options& options,
+                                               ShownBy evidence = ShownBy::kFitAndForecast) {
   const Trial null = judge.trial(models::ChannelCorrection{});
   if (null.forecast.empty()) return std::nullopt;
   Trial best;
@@ -254,7 +257,8 @@ std::optional<Reidentified> judged_as_forecast(const Judge& judge, const Channel
     Trial t = judge.trial(effect);
     if (t.first_half_sse < best.first_half_sse) best = std::move(t);
   }
-  const std::optional<double> explains = forecast_explains(null, best, ch, judge.half(), options);
+  const std::optional<double> explains =
+      forecast_explains(null, best, ch, judge.half(), options, evidence);
   if (!explains) return std::nullopt;
   std::optional<Reidentified> r = identified_whole(judge, best.effect, ch, *explains);
   if (r) r->fit_explains = 1.0 - best.first_half_sse / null.first_half_sse;
@@ -297,7 +301,7 @@ std::string lags_of(const models::SideModel& side) {
 std::optional<Reidentified> reidentified_leak(const models::TransducerModel& model,
                                               const Signals& s, const ChannelData& ch,
                                               const std::vector<double>& current,
-                                              const Options& options) {
+                                              const Options& options, ShownBy evidence) {
   if (!ch.sensed || !reidentifiable(model, s, ch)) return std::nullopt;
   const Judge judge(model, s, ch);
   const auto neighbours = [](const models::ChannelCorrection& c) {
@@ -305,7 +309,7 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
                                                   scaled(c, 1.0 / std::sqrt(3.0))};
   };
   std::optional<Reidentified> r =
-      judged_as_forecast(judge, ch, coarse_leaks(s), neighbours, options);
+      judged_as_forecast(judge, ch, coarse_leaks(s), neighbours, options, evidence);
   if (!r) return std::nullopt;
   const models::ChannelCorrection& leak = r->correction;
   r->candidate = &candidate_using(leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage
@@ -367,7 +371,8 @@ std::optional<Reidentified> reidentified_creep(const models::TransducerModel& mo
   const Judge with_creep(s, ch, kWithCreep);
   const Trial null = as_is.trial(beside);
   const Trial creep = with_creep.trial(beside);
-  const std::optional<double> explains = forecast_explains(null, creep, ch, as_is.half(), options);
+  const std::optional<double> explains =
+      forecast_explains(null, creep, ch, as_is.half(), options, ShownBy::kFitAndForecast);
   if (!explains) return std::nullopt;
   std::optional<Reidentified> r = identified_whole(with_creep, beside, ch, *explains);
   if (!r) return std::nullopt;

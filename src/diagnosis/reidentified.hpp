@@ -24,6 +24,7 @@
 // Only the sensor side of field-drive models with one side per channel (not vectorial).
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -62,12 +63,19 @@ struct Reidentified {
 [[nodiscard]] std::vector<Segment> where_it_changes(const std::vector<double>& output,
                                                     const std::vector<double>& current);
 
+// What a re-identified effect must show: the identification's own evidence (the first half
+// fitted by min_explains better) and the forecast, or the forecast alone. Beside a creep
+// structure the fit cannot show a slow leak: over the half it is fitted on, the slowest lags
+// integrate like the leak and take it in; past it the lags settle and the leak keeps
+// integrating, which only the forecast sees.
+enum class ShownBy : std::uint8_t { kFitAndForecast, kForecast };
+
 // The best form of leak when it is significant; nullopt otherwise (or when the model or the
 // recording does not allow the test).
-[[nodiscard]] std::optional<Reidentified> reidentified_leak(const models::TransducerModel& model,
-                                                            const Signals& s, const ChannelData& ch,
-                                                            const std::vector<double>& current,
-                                                            const Options& options);
+[[nodiscard]] std::optional<Reidentified> reidentified_leak(
+    const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
+    const std::vector<double>& current, const Options& options,
+    ShownBy evidence = ShownBy::kFitAndForecast);
 
 // Creep judged the same way where the model has no creep operators (a `hysteresis` model): a
 // loop identified on a creeping stack bends to the creep, and lags added after it carry little
