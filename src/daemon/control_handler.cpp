@@ -71,7 +71,10 @@ nlohmann::json ControlHandler::send(runtime::LoopCommand command, const char* wh
                          runtime::to_string(answer->state) +
                          (answer->state == runtime::LoopState::kFaulted ? " (reset first)" : ""));
     case runtime::CommandResult::kRefusedCause:
-      return error_reply(std::string(what) + ": a fault's cause is still present");
+      // Not faulted: a reset had only health warnings to clear, all still beyond their bands.
+      return error_reply(std::string(what) + (answer->state == runtime::LoopState::kFaulted
+                                                  ? ": a fault's cause is still present"
+                                                  : ": a health warning is still beyond its band"));
     case runtime::CommandResult::kInvalid:
       break;
   }

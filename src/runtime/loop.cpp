@@ -153,13 +153,7 @@ void Loop::handle(const LoopCommand& c) noexcept {
       return answer(c, CommandResult::kDone);
     }
     case CommandKind::kReset:
-      if (alarms_) static_cast<void>(alarms_->reset());
-      if (supervisor_.state() != LoopState::kFaulted) {
-        return answer(c, CommandResult::kRefusedState);
-      }
-      if (active_causes_ != 0) return answer(c, CommandResult::kRefusedCause);
-      supervisor_.reset();
-      return answer(c, CommandResult::kDone);
+      return answer(c, reset());
     case CommandKind::kSetpoint:
       hold_setpoint_ = c.value;
       wave_running_ = false;
@@ -205,6 +199,22 @@ void Loop::handle(const LoopCommand& c) noexcept {
       ++status_.model_swaps;
       return answer(c, CommandResult::kDone);
   }
+}
+
+// A refused reset changes nothing: the checks come before anything is cleared.
+CommandResult Loop::reset() noexcept {
+  const std::uint32_t latched = alarms_ ? alarms_->latched() : 0U;
+  const std::uint32_t clearable = alarms_ ? latched & ~alarms_->active() : 0U;
+  if (supervisor_.state() == LoopState::kFaulted) {
+    if (active_causes_ != 0) return CommandResult::kRefusedCause;
+    supervisor_.reset();
+  } else if (clearable == 0U) {
+    // Not faulted: only warnings to clear. None latched: nothing to reset; all still beyond
+    // their bands: their cause lasts.
+    return latched == 0U ? CommandResult::kRefusedState : CommandResult::kRefusedCause;
+  }
+  if (alarms_) static_cast<void>(alarms_->reset());
+  return CommandResult::kDone;
 }
 
 models::Reconstruction::Estimate Loop::estimate(double e, double d) noexcept {

@@ -25,7 +25,13 @@
 // rejected) and evaluates the alarm bands (adaptation::HealthAlarms) every status period, with
 // the adaptation's equivalent temperature when it runs. An alarm latches as a warning (status
 // `health`); with bands.fault it is also Fault::kHealth, a cause in every cycle while it is
-// beyond its band. kReset clears the warnings back inside their bands, in any state.
+// beyond its band. kReset clears the warnings back inside their bands, in any state; a reset
+// it answers with a refusal changes nothing (not the supervisor, not a warning):
+//   faulted, a fault cause in the last cycle      kRefusedCause
+//   faulted, no cause                             kDone: faults and clearable warnings cleared
+//   not faulted, a warning back inside its band   kDone: those warnings cleared
+//   not faulted, warnings all beyond their bands  kRefusedCause
+//   not faulted, no warning latched               kRefusedState (nothing to reset)
 //
 // Threads: cycle() runs on the real-time thread only. submit(), take_answer(), take_retired()
 // and status() are for one control thread (single producer / single consumer rings), status()
@@ -132,6 +138,7 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
        SampleSink* sink);
   void handle(const LoopCommand& c) noexcept;
   void answer(const LoopCommand& c, CommandResult r) noexcept;
+  [[nodiscard]] CommandResult reset() noexcept;
   [[nodiscard]] double safe_command() const noexcept;
   [[nodiscard]] double setpoint() noexcept;
   [[nodiscard]] models::Reconstruction::Estimate estimate(double e, double d) noexcept;
