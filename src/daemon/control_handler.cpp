@@ -195,7 +195,7 @@ nlohmann::json ControlHandler::status() {
         {"T", number_or_null(s.last.t_ref)}}},
       {"wave_running", s.wave_running},
       {"adaptation", adaptation_json(s.adaptation)},
-      {"health", health_json(s.health)},
+      {"health", health_json(s.health, daemon_->health_state_at_start())},
       {"model",
        {{"path", running.model.string()},
         {"hash", hex(running.model_hash)},

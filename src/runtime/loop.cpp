@@ -135,8 +135,15 @@ void Loop::handle(const LoopCommand& c) noexcept {
       ramp_left_ = 0;
       return answer(c, supervisor_.disarm() ? CommandResult::kDone : CommandResult::kRefusedState);
     case CommandKind::kSaveState: {
+      if (!c.health_state.empty() && c.health_state.size() != health_state_size()) {
+        return answer(c, CommandResult::kInvalid);
+      }
       const bool saved = c.state != nullptr &&
                          (adapted_ ? adapted_->save_state(*c.state) : model_->save_state(*c.state));
+      if (saved && !c.health_state.empty()) {
+        health_->save_state(c.health_state.first(adaptation::HealthEstimator::kStateSize));
+        alarms_->save_state(c.health_state.subspan(adaptation::HealthEstimator::kStateSize));
+      }
       return answer(c, saved ? CommandResult::kDone : CommandResult::kInvalid);
     }
     case CommandKind::kAdapt:
@@ -248,6 +255,15 @@ void Loop::follow_health(bool accepted, double e, double d) noexcept {
     active_causes_ |= bit(Fault::kHealth);
     supervisor_.report(Fault::kHealth, cycle_);
   }
+}
+
+bool Loop::restore_health_state(std::span<const double> in) noexcept {
+  if (!health_ || in.size() != kHealthStateSize) return false;
+  health_->restore_state(in.first(adaptation::HealthEstimator::kStateSize));
+  alarms_->restore_state(in.subspan(adaptation::HealthEstimator::kStateSize));
+  publish_health();
+  published_.publish(status_);
+  return true;
 }
 
 void Loop::publish_health() noexcept {

@@ -25,7 +25,10 @@
 // rejected) and evaluates the alarm bands (adaptation::HealthAlarms) every status period, with
 // the adaptation's equivalent temperature when it runs. An alarm latches as a warning (status
 // `health`); with bands.fault it is also Fault::kHealth, a cause in every cycle while it is
-// beyond its band. kReset clears the warnings back inside their bands, in any state; a reset
+// beyond its band. Its state (the estimator's, then the alarms' latches) is saved with the
+// model's by kSaveState and restored by restore_health_state() before the first cycle, so a
+// restart keeps the baseline, the trends and the latched warnings. kReset clears the warnings
+// back inside their bands, in any state; a reset
 // it answers with a refusal changes nothing (not the supervisor, not a warning):
 //   faulted, a fault cause in the last cycle      kRefusedCause
 //   faulted, no cause                             kDone: faults and clearable warnings cleared
@@ -42,6 +45,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
@@ -127,6 +131,17 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
   [[nodiscard]] const StatusSnapshot& local_status() const noexcept { return status_; }
   // Timing figures from the runner, published with the next snapshot.
   void set_timing(const StatusSnapshot& timing) noexcept;
+
+  // The health state: adaptation::HealthEstimator's, then adaptation::HealthAlarms' (latched
+  // bits and raise times). 0 when health is off.
+  static constexpr std::size_t kHealthStateSize{adaptation::HealthEstimator::kStateSize +
+                                                adaptation::HealthAlarms::kStateSize};
+  [[nodiscard]] std::size_t health_state_size() const noexcept {
+    return health_ ? kHealthStateSize : 0;
+  }
+  // Before the first cycle (the loop thread not yet running): false, nothing restored, when
+  // health is off or the span's size is not health_state_size(). The status shows it at once.
+  bool restore_health_state(std::span<const double> in) noexcept;
 
   [[nodiscard]] const Supervisor& supervisor() const noexcept { return supervisor_; }
   [[nodiscard]] const Controller& controller() const noexcept { return controller_; }
