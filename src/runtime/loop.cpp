@@ -225,9 +225,11 @@ CommandResult Loop::reset() noexcept {
 }
 
 models::Reconstruction::Estimate Loop::estimate(double e, double d) noexcept {
+  predicted_d_ = adaptation::HealthEstimator::kNoPrediction;
   if (!adapted_) return model_->step(e, d);
   // Learning only from a sample nothing else in this cycle found wrong.
   const adaptation::AdaptedReconstruction::Estimate a = adapted_->step(e, d, active_causes_ == 0);
+  if (a.status == models::SampleStatus::kOk) predicted_d_ = a.predicted_sensed;
   return {a.stress, a.strain, a.status};
 }
 
@@ -244,7 +246,7 @@ void Loop::publish_adaptation() noexcept {
 
 void Loop::follow_health(bool accepted, double e, double d) noexcept {
   if (!health_) return;
-  static_cast<void>(health_->step(e, d, accepted));
+  static_cast<void>(health_->step(e, d, predicted_d_, accepted));
   if (cycle_ % config_.status_period == 0) {
     const bool has_temperature = adapted_ != nullptr;
     const double temperature = has_temperature ? adapted_->drift().temperature_degc : 0.0;
@@ -337,8 +339,9 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
     }
     sample.t_hat = est.stress;
     sample.s_hat = est.strain;
-  } else if (adapted_) {
-    adapted_->skip();
+  } else {
+    predicted_d_ = adaptation::HealthEstimator::kNoPrediction;
+    if (adapted_) adapted_->skip();
   }
   follow_health(read == DriverStatus::kOk && active_causes_ == 0, in.e, in.d);
   supervisor_.note_cycle(overrun, cycle_, missed);

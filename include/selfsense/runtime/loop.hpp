@@ -22,13 +22,14 @@
 //
 // Health (LoopConfig::health_enabled): the loop steps adaptation::HealthEstimator with the
 // measured E and D of every cycle (a sample with any fault cause in its cycle is passed as
-// rejected) and evaluates the alarm bands (adaptation::HealthAlarms) every status period, with
-// the adaptation's equivalent temperature when it runs. An alarm latches as a warning (status
-// `health`); with bands.fault it is also Fault::kHealth, a cause in every cycle while it is
-// beyond its band. Its state (the estimator's, then the alarms' latches) is saved with the
-// model's by kSaveState and restored by restore_health_state() before the first cycle, so a
-// restart keeps the baseline, the trends and the latched warnings. kReset clears the warnings
-// back inside their bands, in any state; a reset
+// rejected) and, under adaptation, the model's predicted D for the same field path (the loop
+// the loss of polarisation is measured against; without adaptation none) and evaluates the alarm
+// bands (adaptation::HealthAlarms) every status period, with the adaptation's equivalent
+// temperature when it runs. An alarm latches as a warning (status `health`); with bands.fault it is
+// also Fault::kHealth, a cause in every cycle while it is beyond its band. Its state (the
+// estimator's, then the alarms' latches) is saved with the model's by kSaveState and restored by
+// restore_health_state() before the first cycle, so a restart keeps the baseline, the trends and
+// the latched warnings. kReset clears the warnings back inside their bands, in any state; a reset
 // it answers with a refusal changes nothing (not the supervisor, not a warning):
 //   faulted, a fault cause in the last cycle      kRefusedCause
 //   faulted, no cause                             kDone: faults and clearable warnings cleared
@@ -186,6 +187,7 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
   double s_hat_{0.0};
   double t_hat_{0.0};
   bool estimate_valid_{false};
+  double predicted_d_{0.0};         // the adapted model's predicted D (health's reference), or NaN
   std::uint32_t active_causes_{0};  // faults seen in the current cycle
   // Ramped stop: the command it starts from, its length and the cycles left [cycles].
   double ramp_from_{0.0};
