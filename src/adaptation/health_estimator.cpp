@@ -79,8 +79,7 @@ double HealthEstimator::time_s() const noexcept {
   return static_cast<double>(samples_) * ts_;
 }
 
-bool HealthEstimator::step(double field, double sensed, double predicted,
-                           bool accepted) noexcept {
+bool HealthEstimator::step(double field, double sensed, double predicted, bool accepted) noexcept {
   ++samples_;
   if (!accepted || !std::isfinite(field) || !std::isfinite(sensed)) {
     drop();
@@ -139,8 +138,8 @@ void HealthEstimator::follow_reversals(double e, double d, double p) noexcept {
   extreme_d_ = d;
 }
 
-void HealthEstimator::on_reversal(bool at_minimum, double e, double d, double p,
-                                  double extreme_e, double c_rev) noexcept {
+void HealthEstimator::on_reversal(bool at_minimum, double e, double d, double p, double extreme_e,
+                                  double c_rev) noexcept {
   if (!at_minimum) {
     if (in_cycle_) {
       top_seen_ = true;
