@@ -54,10 +54,10 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
                        (pulse ? pulse_n_.load(std::memory_order_relaxed) : 0.0);
   const double t = static_cast<double>(cycles_) * sample_time_;
   const double share = ramp_.ramp_s > 0.0 ? std::min(1.0, t / ramp_.ramp_s) : 1.0;
-  temperature_degc_ =
+  const double ambient_degc =
       ramp_.start_degc + (ramp_.end_degc - ramp_.start_degc) * share +
       ramp_.swing_degc * std::sin(2.0 * std::numbers::pi * t / ramp_.swing_period_s);
-  const plant::StepInput input{command_, force, temperature_degc_};
+  const plant::StepInput input{command_, force, ambient_degc};
   plant::StepOutput o{};
   // The plant may run several steps per loop cycle; a fault flag raised in any of them is the
   // device's (like the sticky bits of a status register), not only one in the step read last.
@@ -68,6 +68,7 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
     status |= o.status;
     latency_s = std::max(latency_s, o.latency_s);
   }
+  temperature_degc_ = o.temp_degc;  // with the plant's self-heating
   ++cycles_;
   cycle_published_.store(cycles_, std::memory_order_relaxed);
   out.e = o.e_meas_v_per_m;

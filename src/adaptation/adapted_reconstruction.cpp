@@ -134,7 +134,8 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field,
   const Drift dr = estimator_.drift();
   const double unloaded = fixed_s + (1.0 + dr.permittivity) * ps.linear + (1.0 + dr.loop) * ps.loop;
   Estimate out{(sensed - unloaded) / ((1.0 + dr.coupling) * s.coupling()), kNaN,
-               models::SampleStatus::kOk};
+               models::SampleStatus::kOk,
+               fixed_s + ps.linear + ps.loop + s.coupling() * mount_stress};
   if (kernel_.actuator()) {
     const models::SideOperator& a = *kernel_.actuator();
     out.strain = fixed_a + (1.0 + dr.coupling) * pa.linear + (1.0 + dr.loop) * pa.loop +

@@ -62,4 +62,25 @@ std::uint32_t HealthAlarms::reset() noexcept {
   return latched_;
 }
 
+void HealthAlarms::save_state(std::span<double> out) const noexcept {
+  if (out.size() < kStateSize) return;
+  out[0] = static_cast<double>(latched_);
+  for (std::size_t i = 0; i < kHealthAlarmCount; ++i)
+    out[1 + i] = raised_at_s_[i];
+}
+
+void HealthAlarms::restore_state(std::span<const double> in) noexcept {
+  if (in.size() < kStateSize) return;
+  constexpr std::uint32_t kAll = (1U << kHealthAlarmCount) - 1U;
+  const double bits = in[0];
+  latched_ = std::isfinite(bits) && bits >= 0.0 && bits <= static_cast<double>(kAll)
+                 ? static_cast<std::uint32_t>(bits)
+                 : 0U;
+  active_ = 0;
+  for (std::size_t i = 0; i < kHealthAlarmCount; ++i) {
+    const bool latched = (latched_ & (1U << i)) != 0U;
+    raised_at_s_[i] = latched && std::isfinite(in[1 + i]) ? in[1 + i] : -1.0;
+  }
+}
+
 }  // namespace selfsense::adaptation

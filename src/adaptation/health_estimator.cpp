@@ -55,6 +55,9 @@ bool HealthEstimatorConfig::is_valid(const std::string& prefix, std::string* why
   if (!(depolarisation_sensitivity > 0.0 && depolarisation_sensitivity <= 2.0)) {
     return fail(why, prefix + "depolarisation_sensitivity: must be in (0, 2]");
   }
+  if (!(max_span_change > 0.0 && max_span_change <= 1.0)) {
+    return fail(why, prefix + "max_span_change: must be in (0, 1]");
+  }
   return true;
 }
 
@@ -76,17 +79,18 @@ double HealthEstimator::time_s() const noexcept {
   return static_cast<double>(samples_) * ts_;
 }
 
-bool HealthEstimator::step(double field, double sensed, bool accepted) noexcept {
+bool HealthEstimator::step(double field, double sensed, double predicted, bool accepted) noexcept {
   ++samples_;
   if (!accepted || !std::isfinite(field) || !std::isfinite(sensed)) {
     drop();
     return false;
   }
   const std::uint64_t before = cycles_;
-  follow_reversals(field, sensed);
+  follow_reversals(field, sensed, predicted);
   follow_hold(field, sensed);
   last_e_ = field;
   last_d_ = sensed;
+  last_p_ = predicted;
   return cycles_ != before;
 }
 
@@ -98,7 +102,7 @@ void HealthEstimator::drop() noexcept {
   in_hold_ = false;
 }
 
-void HealthEstimator::follow_reversals(double e, double d) noexcept {
+void HealthEstimator::follow_reversals(double e, double d, double p) noexcept {
   const double delta = config_.reversal_field_v_per_m;
   if (!has_last_) {
     has_last_ = true;
@@ -107,7 +111,10 @@ void HealthEstimator::follow_reversals(double e, double d) noexcept {
     extreme_d_ = d;
     return;
   }
-  if (in_cycle_) area_ += 0.5 * (e + last_e_) * (d - last_d_);
+  if (in_cycle_) {
+    area_ += 0.5 * (e + last_e_) * (d - last_d_);
+    area_p_ += 0.5 * (e + last_e_) * (p - last_p_);  // NaN from a missing prediction on
+  }
   if (direction_ == 0) {
     // The first move of delta sets the direction; no reversal is declared before it.
     if (std::abs(e - first_e_) >= delta) {
@@ -125,13 +132,13 @@ void HealthEstimator::follow_reversals(double e, double d) noexcept {
   }
   if (std::abs(e - extreme_e_) < delta) return;
   const double c_rev = (d - extreme_d_) / (e - extreme_e_);
-  on_reversal(!rising, e, d, extreme_e_, c_rev);
+  on_reversal(!rising, e, d, p, extreme_e_, c_rev);
   direction_ = rising ? -1 : 1;
   extreme_e_ = e;
   extreme_d_ = d;
 }
 
-void HealthEstimator::on_reversal(bool at_minimum, double e, double d, double extreme_e,
+void HealthEstimator::on_reversal(bool at_minimum, double e, double d, double p, double extreme_e,
                                   double c_rev) noexcept {
   if (!at_minimum) {
     if (in_cycle_) {
@@ -141,18 +148,21 @@ void HealthEstimator::on_reversal(bool at_minimum, double e, double d, double ex
     }
     return;
   }
-  if (in_cycle_ && top_seen_) finish_cycle(e, d);
+  if (in_cycle_ && top_seen_) finish_cycle(e, d, p);
   in_cycle_ = true;
   top_seen_ = false;
   area_ = 0.0;
+  area_p_ = 0.0;
   start_e_ = e;
   start_d_ = d;
+  start_p_ = p;
   cycle_min_e_ = extreme_e;
   cycle_c_sum_ = c_rev;
 }
 
-void HealthEstimator::finish_cycle(double e, double d) noexcept {
+void HealthEstimator::finish_cycle(double e, double d, double p) noexcept {
   const double w = area_ + 0.5 * (e + start_e_) * (start_d_ - d);
+  const double wp = area_p_ + 0.5 * (e + start_e_) * (start_p_ - p);  // NaN: no prediction
   const double c = 0.5 * cycle_c_sum_;
   const double t = time_s();
   if (!std::isfinite(w) || !std::isfinite(c)) return;
@@ -180,15 +190,28 @@ void HealthEstimator::finish_cycle(double e, double d) noexcept {
     const double k = base_n_ + 1.0;
     base_c_ = k == 1.0 ? c : base_c_ + (c - base_c_) / k;
     base_w_ = k == 1.0 ? w : base_w_ + (w - base_w_) / k;
+    if (!(wp > 0.0)) {
+      base_wp_ = -1.0;  // a baseline cycle without a prediction: none for this baseline
+    } else if (k == 1.0 || base_wp_ > 0.0) {
+      base_wp_ = k == 1.0 ? wp : base_wp_ + (wp - base_wp_) / k;
+    }
     base_min_ = base_min_ + (cycle_min_e_ - base_min_) / k;
     base_max_ = base_max_ + (cycle_max_e_ - base_max_) / k;
     base_n_ = k;
     return;
   }
-  if (!same_extremes(base_span) || !(base_c_ != 0.0) || !(base_w_ > 0.0)) return;
+  if (!(base_c_ != 0.0) || !(base_w_ > 0.0)) return;
+  const bool by_model = config_.model_reference && base_wp_ > 0.0 && wp > 0.0;
+  if (by_model) {
+    const double span = cycle_max_e_ - cycle_min_e_;
+    if (!(std::abs(span / base_span - 1.0) <= config_.max_span_change)) return;
+  } else if (!same_extremes(base_span)) {
+    return;
+  }
+  const double ratio = by_model ? (w / wp) / (base_w_ / base_wp_) : w / base_w_;
   const double rise = (c / base_c_ - 1.0) / config_.capacitance_per_k;
   const double expected = std::max(1.0 + config_.dissipation_per_k * rise, 0.05);
-  depolarisation_.update((1.0 - (w / base_w_) / expected) / config_.depolarisation_sensitivity, t);
+  depolarisation_.update((1.0 - ratio / expected) / config_.depolarisation_sensitivity, t);
   ++compared_;
 }
 
@@ -251,7 +274,7 @@ HealthFigures HealthEstimator::figures() const noexcept {
 
 void HealthEstimator::save_state(std::span<double> out) const noexcept {
   if (out.size() < kStateSize) return;
-  const double head[11] = {static_cast<double>(samples_),
+  const double head[12] = {static_cast<double>(samples_),
                            has_extremes_ ? 1.0 : 0.0,
                            base_start_s_,
                            base_n_,
@@ -261,9 +284,10 @@ void HealthEstimator::save_state(std::span<double> out) const noexcept {
                            base_max_,
                            static_cast<double>(cycles_),
                            static_cast<double>(compared_),
-                           static_cast<double>(holds_)};
+                           static_cast<double>(holds_),
+                           base_wp_};
   std::copy(std::begin(head), std::end(head), out.begin());
-  std::size_t at = 11;
+  std::size_t at = 12;
   for (const TrendFilter* f : {&capacitance_, &dissipation_, &depolarisation_, &conductivity_}) {
     f->save_state(out.subspan(at, TrendFilter::kStateSize));
     at += TrendFilter::kStateSize;
@@ -286,7 +310,8 @@ void HealthEstimator::restore_state(std::span<const double> in) noexcept {
   cycles_ = count(in[8]);
   compared_ = count(in[9]);
   holds_ = count(in[10]);
-  std::size_t at = 11;
+  base_wp_ = in[11];
+  std::size_t at = 12;
   for (TrendFilter* f : {&capacitance_, &dissipation_, &depolarisation_, &conductivity_}) {
     f->restore_state(in.subspan(at, TrendFilter::kStateSize));
     at += TrendFilter::kStateSize;

@@ -156,7 +156,8 @@ void add_ctl_command(CLI::App& app) {
   add_bare(*ctl, options, "arm", "Arm the loop (from ready)", daemon::ArmRequest{});
   add_bare(*ctl, options, "disarm", "Disarm the loop: the amplifier goes to its safe output",
            daemon::DisarmRequest{});
-  add_bare(*ctl, options, "reset", "Clear latched faults (faulted -> ready)",
+  add_bare(*ctl, options, "reset",
+           "Clear latched faults (faulted -> ready) and health warnings back in their bands",
            daemon::ResetRequest{});
   add_bare(*ctl, options, "reload", "Reload the parameters that are safe to change",
            daemon::ReloadRequest{});

@@ -151,7 +151,8 @@ void run_plant(const PlantOptions& opt) {
   rec.set_column("S", column([](const Out& o) { return o.s; }));
   rec.set_column("T", column([](const Out& o) { return o.t_pa; }));
   const auto [tmin, tmax] = std::minmax_element(ex.temp_degc.begin(), ex.temp_degc.end());
-  if (tmin != ex.temp_degc.end() && *tmin != *tmax) {
+  // The stack's temperature: the input's, which self-heating raises.
+  if ((tmin != ex.temp_degc.end() && *tmin != *tmax) || file.plant.heating.enabled) {
     rec.set_column("temp", column([](const Out& o) { return o.temp_degc; }));
   }
   rec.set_column("u", column([](const Out& o) { return o.u_v; }));

@@ -228,6 +228,8 @@ void read_health(YamlMap h, HealthSection& out) {
   h.read("capacitance_per_k", e.capacitance_per_k);
   h.read("dissipation_per_k", e.dissipation_per_k);
   h.read("depolarisation_sensitivity", e.depolarisation_sensitivity);
+  h.read("model_reference", e.model_reference);
+  h.read("max_span_change", e.max_span_change);
   h.finish();
 }
 

@@ -71,7 +71,10 @@ nlohmann::json ControlHandler::send(runtime::LoopCommand command, const char* wh
                          runtime::to_string(answer->state) +
                          (answer->state == runtime::LoopState::kFaulted ? " (reset first)" : ""));
     case runtime::CommandResult::kRefusedCause:
-      return error_reply(std::string(what) + ": a fault's cause is still present");
+      // Not faulted: a reset had only health warnings to clear, all still beyond their bands.
+      return error_reply(std::string(what) + (answer->state == runtime::LoopState::kFaulted
+                                                  ? ": a fault's cause is still present"
+                                                  : ": a health warning is still beyond its band"));
     case runtime::CommandResult::kInvalid:
       break;
   }
@@ -192,7 +195,7 @@ nlohmann::json ControlHandler::status() {
         {"T", number_or_null(s.last.t_ref)}}},
       {"wave_running", s.wave_running},
       {"adaptation", adaptation_json(s.adaptation)},
-      {"health", health_json(s.health)},
+      {"health", health_json(s.health, daemon_->health_state_at_start())},
       {"model",
        {{"path", running.model.string()},
         {"hash", hex(running.model_hash)},

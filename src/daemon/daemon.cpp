@@ -109,8 +109,28 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
                                                 controller, sink_.get())
               : std::make_unique<runtime::Loop>(config_.loop_config(), *driver_,
                                                 std::move(reconstruction), controller, sink_.get());
+  resume_health();
   runner_ = std::make_unique<runtime::LoopRunner>(
       *loop_, clock_, std::llround(ts * 1e9), rt_options(config_.loop), driver_->cycle_trigger());
+}
+
+void Daemon::resume_health() {
+  health_buffer_.assign(loop_->health_state_size(), 0.0);
+  if (health_buffer_.empty() || config_.model_state.empty()) return;  // "off"
+  if (state_at_start_ != "restored") {
+    health_at_start_ = state_at_start_ == "none" ? "none" : "not restored: nor the model's state";
+  } else if (health_read_.empty()) {
+    health_at_start_ = "none";
+  } else if (!loop_->restore_health_state(health_read_)) {
+    health_at_start_ = "not restored: " + config_.model_state.string() + ": " +
+                       std::to_string(health_read_.size()) + " health values, this version " +
+                       "keeps " + std::to_string(health_buffer_.size());
+  } else {
+    health_at_start_ = "restored";
+  }
+  health_read_.clear();
+  static_cast<void>(
+      std::fprintf(stderr, "selfsensed: health state: %s\n", health_at_start_.c_str()));
 }
 
 void Daemon::restore_model_state(
@@ -125,7 +145,7 @@ void Daemon::restore_model_state(
   }
   try {
     StateOf wrote = StateOf::kPlain;
-    const models::SavedState saved = read_model_state(path, &wrote);
+    const models::SavedState saved = read_model_state(path, &wrote, &health_read_);
     if (wrote != running) {
       // The sizes differ too, but the reason is the configuration, not the file.
       state_at_start_ = "not restored: " + path.string() + ": written by the " +
@@ -158,13 +178,14 @@ Daemon::StateSaved Daemon::save_model_state(const std::filesystem::path& path) {
   runtime::LoopCommand c;
   c.kind = runtime::CommandKind::kSaveState;
   c.state = &state_buffer_;
+  c.health_state = health_buffer_;
   const auto answer = command(c, std::chrono::milliseconds(500));
   if (!answer || answer->result != runtime::CommandResult::kDone) {
     out.error = "the loop did not save the model's state";
     return out;
   }
   try {
-    write_model_state(path, state_buffer_, state_of_);
+    write_model_state(path, state_buffer_, state_of_, health_buffer_);
   } catch (const std::exception& e) {
     out.error = e.what();
     return out;

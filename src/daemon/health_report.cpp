@@ -16,7 +16,7 @@ nlohmann::json figure(bool has, double value) {
 
 }  // namespace
 
-nlohmann::json health_json(const runtime::HealthStatus& h) {
+nlohmann::json health_json(const runtime::HealthStatus& h, std::string_view state_at_start) {
   if (!h.enabled) return {{"enabled", false}};
   const adaptation::HealthFigures& f = h.figures;
   nlohmann::json alarms = nlohmann::json::object();
@@ -28,7 +28,7 @@ nlohmann::json health_json(const runtime::HealthStatus& h) {
         {"raised_at_s",
          (h.latched & b) != 0U ? nlohmann::json(h.raised_at_s[i]) : nlohmann::json(nullptr)}};
   }
-  return {
+  nlohmann::json out = {
       {"enabled", true},
       {"fault", h.fault},
       {"capacitance_f_per_m", figure(f.has_capacitance, f.capacitance_f_per_m)},
@@ -44,6 +44,8 @@ nlohmann::json health_json(const runtime::HealthStatus& h) {
       {"compared_cycles", f.compared_cycles},
       {"holds", f.holds},
       {"alarms", std::move(alarms)}};
+  if (!state_at_start.empty()) out["state_at_start"] = std::string(state_at_start);
+  return out;
 }
 
 std::vector<MetricFamily> health_metrics(const runtime::HealthStatus& h) {

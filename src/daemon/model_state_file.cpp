@@ -6,8 +6,10 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <span>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "selfsense/io/yaml_map.hpp"
@@ -18,11 +20,34 @@ std::string_view to_string(StateOf of) noexcept {
   return of == StateOf::kAdapted ? "adapted" : "plain";
 }
 
+namespace {
+
+void append_values(std::string& text, std::span<const double> values) {
+  char number[32];
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    static_cast<void>(std::snprintf(number, sizeof number, "%.17g", values[i]));
+    text += (i == 0 ? "" : ", ") + std::string(number);
+  }
+}
+
+void read_finite(io::YamlMap& root, const char* key, std::vector<double>& values) {
+  root.read_sequence(key, values);
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) {
+      root.fail(key, "value " + std::to_string(i) + " is not finite");
+    }
+  }
+}
+
+}  // namespace
+
 void write_model_state(const std::filesystem::path& path, const models::SavedState& state,
-                       StateOf of) {
-  for (const double v : state.values) {
-    if (!std::isfinite(v))
-      throw std::runtime_error(path.string() + ": a state value is not finite");
+                       StateOf of, std::span<const double> health) {
+  for (const std::span<const double> values : {std::span<const double>(state.values), health}) {
+    for (const double v : values) {
+      if (!std::isfinite(v))
+        throw std::runtime_error(path.string() + ": a state value is not finite");
+    }
   }
   std::string text = "selfsense_model_state: 1\nstructure: ";
   text += models::to_string(state.identity.structure);
@@ -31,12 +56,14 @@ void write_model_state(const std::filesystem::path& path, const models::SavedSta
   text += std::string("\nparameter_hash: \"") + hash + "\"\nreconstruction: ";
   text += to_string(of);
   text += "\nvalues: [";
-  char number[32];
-  for (std::size_t i = 0; i < state.values.size(); ++i) {
-    static_cast<void>(std::snprintf(number, sizeof number, "%.17g", state.values[i]));
-    text += (i == 0 ? "" : ", ") + std::string(number);
+  append_values(text, state.values);
+  text += "]\n";
+  if (!health.empty()) {
+    text += "health: [";
+    append_values(text, health);
+    text += "]\n";
   }
-  text += "]\ncomplete: true\n";
+  text += "complete: true\n";
   std::filesystem::path temporary = path;
   temporary += ".tmp";
   {
@@ -51,7 +78,8 @@ void write_model_state(const std::filesystem::path& path, const models::SavedSta
     throw std::runtime_error(path.string() + ": cannot replace the model state: " + ec.message());
 }
 
-models::SavedState read_model_state(const std::filesystem::path& path, StateOf* of) {
+models::SavedState read_model_state(const std::filesystem::path& path, StateOf* of,
+                                    std::vector<double>* health) {
   io::YamlMap root = io::YamlMap::load_file(path);
   if (root.required<int>("selfsense_model_state") != 1) {
     root.fail("selfsense_model_state", "unknown format (this version reads 1)");
@@ -78,13 +106,11 @@ models::SavedState read_model_state(const std::filesystem::path& path, StateOf* 
   }
   if (of != nullptr) *of = kind == "adapted" ? StateOf::kAdapted : StateOf::kPlain;
   if (!root.has("values")) root.fail("values", "missing");
-  root.read_sequence("values", state.values);
-  for (std::size_t i = 0; i < state.values.size(); ++i) {
-    if (!std::isfinite(state.values[i])) {
-      root.fail("values", "value " + std::to_string(i) + " is not finite");
-    }
-  }
+  read_finite(root, "values", state.values);
   state.identity.state_size = state.values.size();
+  std::vector<double> health_values;
+  if (root.has("health")) read_finite(root, "health", health_values);
+  if (health != nullptr) *health = std::move(health_values);
   root.finish();
   return state;
 }

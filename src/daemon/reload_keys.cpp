@@ -183,6 +183,10 @@ const std::array kTable{
               differs<&C::health, &H::estimator, &He::dissipation_per_k>},
     ReloadKey{"health.depolarisation_sensitivity", kRefused,
               differs<&C::health, &H::estimator, &He::depolarisation_sensitivity>},
+    ReloadKey{"health.model_reference", kRefused,
+              differs<&C::health, &H::estimator, &He::model_reference>},
+    ReloadKey{"health.max_span_change", kRefused,
+              differs<&C::health, &H::estimator, &He::max_span_change>},
 };
 
 // `key_path` is `row` or lies under it ("row.x", "row[i]...").

@@ -98,6 +98,8 @@ bool PlantConfig::is_valid(std::string* why) const {
   c.non_negative("aging.leakage_resistivity_ohm_m", aging.leakage_resistivity_ohm_m);
   c.non_negative("aging.leakage_growth_per_h", aging.leakage_growth_per_h);
   c.non_negative("aging.start_s", aging.start_s);
+  c.non_negative("heating.thermal_resistance_k_per_w", heating.thermal_resistance_k_per_w);
+  c.positive("heating.time_constant_s", heating.time_constant_s);
 
   c.positive("mechanics.resonance_hz", mechanics.resonance_hz);
   if (mechanics.enabled) {

@@ -120,7 +120,10 @@ PlantConfig validated(const PlantConfig& config) {
 }  // namespace
 
 Plant::Plant(const PlantConfig& config)
-    : config_{validated(config)}, derived_{derive(config_)}, ts_{1.0 / config_.sample_rate_hz} {
+    : config_{validated(config)},
+      derived_{derive(config_)},
+      ts_{1.0 / config_.sample_rate_hz},
+      heating_gain_{-std::expm1(-ts_ / config_.heating.time_constant_s)} {
   if (config_.hysteresis.enabled) everett_ = std::make_unique<EverettTable>(config_.hysteresis);
   reset();
 }
@@ -201,8 +204,9 @@ StepOutput Plant::step(const StepInput& input) noexcept {
   const double length = derived_.length_m;
   const double t_s = static_cast<double>(s.sample) * ts_;
   const MechanicalInput in{
-      with_aging(temperature_scales(c.temperature, input.temp_degc), c.aging, t_s), e, dp,
-      c.mechanics.load_force_n + input.force_n};
+      with_aging(temperature_scales(c.temperature, input.temp_degc + s.heating_rise_k), c.aging,
+                 t_s),
+      e, dp, c.mechanics.load_force_n + input.force_n};
   const double t_c = c.stress.enabled ? solve_stress(c, length, s, in) : 0.0;
   const MechanicalResponse r = respond(c, length, s, in, t_c);
   const double s_free = r.s_inst + s.creep_s.update(r.s_inst);
@@ -231,6 +235,14 @@ StepOutput Plant::step(const StepInput& input) noexcept {
     const double c_lin = capacitance_linear(e);
     s.capacitance_est_f = std::clamp((q - s.q_prev_c) / du, c_lin, 10.0 * c_lin);
   }
+  const double stack_temp_degc = input.temp_degc + s.heating_rise_k;
+  if (c.heating.enabled) {
+    const double volume = electrode_area * c.geometry.layer_thickness_m;
+    const double power =
+        volume * 0.5 * (e + s.last.e_v_per_m) * ((d - s.d0) - s.last.d_c_per_m2) / ts_;
+    s.heating_rise_k +=
+        heating_gain_ * (c.heating.thermal_resistance_k_per_w * power - s.heating_rise_k);
+  }
   s.u_prev_v = u;
   s.q_prev_c = q;
   s.t_prev_pa = stress;
@@ -255,7 +267,7 @@ StepOutput Plant::step(const StepInput& input) noexcept {
   out.q_c = q;
   out.x_m = x;
   out.f_n = stress * c.geometry.cross_section_m2;
-  out.temp_degc = input.temp_degc;
+  out.temp_degc = stack_temp_degc;
   out.polarisation = dp + s.p0;
   out.q_amp_c = q_amp;
   out.latency_s = fx.late_by_s;

@@ -134,6 +134,13 @@ void read_plant(YamlMap p, PlantConfig& c) {
     m->read("start_s", a.start_s);
     m->finish();
   }
+  if (auto m = p.optional_map("heating")) {
+    HeatingConfig& h = c.heating;
+    m->read("enabled", h.enabled);
+    m->read("thermal_resistance_k_per_w", h.thermal_resistance_k_per_w);
+    m->read("time_constant_s", h.time_constant_s);
+    m->finish();
+  }
   if (auto m = p.optional_map("mechanics")) {
     m->read("enabled", c.mechanics.enabled);
     m->read("resonance_hz", c.mechanics.resonance_hz);

@@ -135,8 +135,15 @@ void Loop::handle(const LoopCommand& c) noexcept {
       ramp_left_ = 0;
       return answer(c, supervisor_.disarm() ? CommandResult::kDone : CommandResult::kRefusedState);
     case CommandKind::kSaveState: {
+      if (!c.health_state.empty() && c.health_state.size() != health_state_size()) {
+        return answer(c, CommandResult::kInvalid);
+      }
       const bool saved = c.state != nullptr &&
                          (adapted_ ? adapted_->save_state(*c.state) : model_->save_state(*c.state));
+      if (saved && !c.health_state.empty()) {
+        health_->save_state(c.health_state.first(adaptation::HealthEstimator::kStateSize));
+        alarms_->save_state(c.health_state.subspan(adaptation::HealthEstimator::kStateSize));
+      }
       return answer(c, saved ? CommandResult::kDone : CommandResult::kInvalid);
     }
     case CommandKind::kAdapt:
@@ -153,13 +160,7 @@ void Loop::handle(const LoopCommand& c) noexcept {
       return answer(c, CommandResult::kDone);
     }
     case CommandKind::kReset:
-      if (alarms_) static_cast<void>(alarms_->reset());
-      if (supervisor_.state() != LoopState::kFaulted) {
-        return answer(c, CommandResult::kRefusedState);
-      }
-      if (active_causes_ != 0) return answer(c, CommandResult::kRefusedCause);
-      supervisor_.reset();
-      return answer(c, CommandResult::kDone);
+      return answer(c, reset());
     case CommandKind::kSetpoint:
       hold_setpoint_ = c.value;
       wave_running_ = false;
@@ -207,10 +208,28 @@ void Loop::handle(const LoopCommand& c) noexcept {
   }
 }
 
+// A refused reset changes nothing: the checks come before anything is cleared.
+CommandResult Loop::reset() noexcept {
+  const std::uint32_t latched = alarms_ ? alarms_->latched() : 0U;
+  const std::uint32_t clearable = alarms_ ? latched & ~alarms_->active() : 0U;
+  if (supervisor_.state() == LoopState::kFaulted) {
+    if (active_causes_ != 0) return CommandResult::kRefusedCause;
+    supervisor_.reset();
+  } else if (clearable == 0U) {
+    // Not faulted: only warnings to clear. None latched: nothing to reset; all still beyond
+    // their bands: their cause lasts.
+    return latched == 0U ? CommandResult::kRefusedState : CommandResult::kRefusedCause;
+  }
+  if (alarms_) static_cast<void>(alarms_->reset());
+  return CommandResult::kDone;
+}
+
 models::Reconstruction::Estimate Loop::estimate(double e, double d) noexcept {
+  predicted_d_ = adaptation::HealthEstimator::kNoPrediction;
   if (!adapted_) return model_->step(e, d);
   // Learning only from a sample nothing else in this cycle found wrong.
   const adaptation::AdaptedReconstruction::Estimate a = adapted_->step(e, d, active_causes_ == 0);
+  if (a.status == models::SampleStatus::kOk) predicted_d_ = a.predicted_sensed;
   return {a.stress, a.strain, a.status};
 }
 
@@ -227,7 +246,7 @@ void Loop::publish_adaptation() noexcept {
 
 void Loop::follow_health(bool accepted, double e, double d) noexcept {
   if (!health_) return;
-  static_cast<void>(health_->step(e, d, accepted));
+  static_cast<void>(health_->step(e, d, predicted_d_, accepted));
   if (cycle_ % config_.status_period == 0) {
     const bool has_temperature = adapted_ != nullptr;
     const double temperature = has_temperature ? adapted_->drift().temperature_degc : 0.0;
@@ -238,6 +257,15 @@ void Loop::follow_health(bool accepted, double e, double d) noexcept {
     active_causes_ |= bit(Fault::kHealth);
     supervisor_.report(Fault::kHealth, cycle_);
   }
+}
+
+bool Loop::restore_health_state(std::span<const double> in) noexcept {
+  if (!health_ || in.size() != kHealthStateSize) return false;
+  health_->restore_state(in.first(adaptation::HealthEstimator::kStateSize));
+  alarms_->restore_state(in.subspan(adaptation::HealthEstimator::kStateSize));
+  publish_health();
+  published_.publish(status_);
+  return true;
 }
 
 void Loop::publish_health() noexcept {
@@ -311,8 +339,9 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
     }
     sample.t_hat = est.stress;
     sample.s_hat = est.strain;
-  } else if (adapted_) {
-    adapted_->skip();
+  } else {
+    predicted_d_ = adaptation::HealthEstimator::kNoPrediction;
+    if (adapted_) adapted_->skip();
   }
   follow_health(read == DriverStatus::kOk && active_causes_ == 0, in.e, in.d);
   supervisor_.note_cycle(overrun, cycle_, missed);

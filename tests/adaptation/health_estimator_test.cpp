@@ -21,6 +21,7 @@ namespace selfsense::adaptation {
 namespace {
 
 static_assert(noexcept(std::declval<HealthEstimator&>().step(0.0, 0.0, true)));
+static_assert(noexcept(std::declval<HealthEstimator&>().step(0.0, 0.0, 0.0, true)));
 
 constexpr double kTs = 1e-4;
 constexpr double kC = 2.0e-8;    // [F/m]
@@ -157,6 +158,42 @@ TEST(HealthEstimator, ADriveOfOtherExtremesIsNotComparedWithTheBaseline) {
   EXPECT_EQ(h.figures().compared_cycles, compared);
 }
 
+// With the model's predicted D for the same field path (here the stack as new: the same
+// capacitance and a play of the same threshold at loop scale 1), a cycle of other extremes is
+// compared: the drive raised by 10 % after a 5 % loss, as a position loop makes up the stroke.
+TEST(HealthEstimator, AgainstTheModelsLoopADriveOfOtherExtremesIsCompared) {
+  for (const bool model_reference : {true, false}) {
+    HealthEstimatorConfig c = quick();
+    c.model_reference = model_reference;
+    HealthEstimator h(c, kTs);
+    Synthetic s;
+    Synthetic model;
+    double t = 0.0;
+    const auto run_with = [&](double amplitude, double seconds) {
+      const auto n = static_cast<long>(seconds / kTs);
+      for (long k = 0; k < n; ++k) {
+        t += kTs;
+        const double e = amplitude * drive(t);
+        const double d = s.d(e);
+        h.step(e, d, model.d(e), true);
+      }
+    };
+    run_with(1.0, 10.0);
+    ASSERT_TRUE(h.figures().baseline_ready);
+    const std::uint64_t compared = h.figures().compared_cycles;
+    s.loop_scale = 0.95;
+    run_with(1.1, 200.0);  // ten trend times
+    const HealthFigures f = h.figures();
+    if (model_reference) {
+      EXPECT_GT(f.compared_cycles, compared + 900U);
+      EXPECT_NEAR(f.depolarisation, 0.05, 1e-3);  // 5 % within 0.1 % of polarisation
+    } else {
+      // The span moved by 10 %: not compared (but the cycle that ends at the change).
+      EXPECT_LE(f.compared_cycles, compared + 1U);
+    }
+  }
+}
+
 TEST(HealthEstimator, LeakageResistivityFromAHold) {
   HealthEstimator h(quick(), kTs);
   Synthetic s;
@@ -232,6 +269,10 @@ TEST(HealthEstimator, TheConfigurationNamesTheViolatedKey) {
   c.depolarisation_sensitivity = 0.0;
   EXPECT_FALSE(c.is_valid("health.", &why));
   EXPECT_EQ(why, "health.depolarisation_sensitivity: must be in (0, 2]");
+  c = {};
+  c.max_span_change = 0.0;
+  EXPECT_FALSE(c.is_valid("health.", &why));
+  EXPECT_EQ(why, "health.max_span_change: must be in (0, 1]");
   c = {};
   c.reversal_field_v_per_m = -1.0;
   EXPECT_THROW(HealthEstimator(c, kTs), std::invalid_argument);

@@ -8,8 +8,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "daemon/recording_support.hpp"
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
@@ -140,6 +142,31 @@ TEST(ModelStateFile, ACutOrMalformedFileIsNamedByLineAndKey) {
   EXPECT_NE(error_of(bad).find(":5: values[1]"), std::string::npos) << error_of(bad);
   testing::write_text(bad, edited("complete", "spare: 1\ncomplete"));
   EXPECT_NE(error_of(bad).find("spare"), std::string::npos) << error_of(bad);
+}
+
+TEST(ModelStateFile, TheHealthKeyRoundTripsAndIsOptional) {
+  const testing::ScratchDir dir("model-state-health");
+  models::SavedState s;
+  s.identity = {models::Structure::kHysteresisCreep, 0x0123456789abcdefULL, 2};
+  s.values = {1.0, 0.5};
+  const std::vector<double> health = {std::numbers::pi, -1.0, 1e-300, 0.0};
+  const std::filesystem::path path = dir.path() / "state.yaml";
+  write_model_state(path, s, StateOf::kPlain, health);
+  std::vector<double> read;
+  EXPECT_EQ(read_model_state(path, nullptr, &read).values, s.values);
+  EXPECT_EQ(read, health);     // %.17g: bit for bit
+  write_model_state(path, s);  // no health: no key, and the reader says none
+  EXPECT_EQ(testing::read_text(path).find("health"), std::string::npos);
+  static_cast<void>(read_model_state(path, nullptr, &read));
+  EXPECT_TRUE(read.empty());
+  const std::vector<double> infinite = {1.0, std::numeric_limits<double>::infinity()};
+  EXPECT_THROW(write_model_state(path, s, StateOf::kPlain, infinite), std::runtime_error);
+  testing::write_text(path,
+                      "selfsense_model_state: 1\nstructure: hysteresis-creep\n"
+                      "parameter_hash: \"0123456789abcdef\"\nvalues: [1]\n"
+                      "health: [1, .nan]\ncomplete: true\n");
+  EXPECT_NE(error_of(path).find(":5: health[1]: expected a finite number"), std::string::npos)
+      << error_of(path);
 }
 
 }  // namespace

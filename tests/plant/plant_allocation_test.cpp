@@ -12,6 +12,7 @@ namespace {
 
 TEST(PlantAllocation, StepSaveRestoreAndFaultsDoNotAllocate) {
   PlantFile file = load_plant_file(test::config_dir() / "all_effects.yaml");
+  file.plant.heating.enabled = true;  // the self-heating's step too
   Plant plant{file.plant};
   double sink = 0.0;
   selfsense::test::AllocationCounter counter;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <vector>
 
 #include "selfsense/control/filter_design.hpp"
 #include "selfsense/control/wave_generator.hpp"
@@ -101,6 +102,8 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
       adapt ? adaptation::AdaptedReconstruction(model, adaptation::DriftEstimatorConfig{}, kTs)
                   .make_saved_state()
             : next_model->make_saved_state();
+  // And the health state's, saved with it when health runs.
+  std::vector<double> health_state(loop.health_state_size(), 0.0);
   int adapts_done = 0;
   std::uint64_t frozen_updates = 0;
   int tunes_done = 0;
@@ -130,6 +133,7 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
       if (phase == 15000) {
         c = {id, CommandKind::kSaveState};
         c.state = &state;
+        c.health_state = health_state;
         state_id = id;
       }
       if (phase == 20000) c = {id, CommandKind::kRampDown, 0.05};  // a ramped stop in each mode
@@ -191,6 +195,8 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
     EXPECT_TRUE(h.figures.has_capacitance);
     EXPECT_NE(h.latched, 0U);
     EXPECT_EQ(loop.supervisor().record(Fault::kHealth).count, 0U);  // warnings, not faults
+    EXPECT_EQ(health_state.size(), Loop::kHealthStateSize);
+    EXPECT_NE(health_state[0], 0.0);  // the sample count: the dumps wrote it
   }
 }
 

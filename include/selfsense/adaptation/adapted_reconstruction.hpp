@@ -76,6 +76,10 @@ class AdaptedReconstruction final {
     double stress{0.0};  // T_hat [Pa]
     double strain{0.0};  // S_hat [-]; NaN without an actuator side
     models::SampleStatus status{models::SampleStatus::kOk};
+    // The model's D for the field path as identified (no drift), with the mount's predicted
+    // stress: y0_s + q_s E^2 + L_s + H_s + d_s T_mount [C/m^2] (the health estimate's
+    // reference loop, health_estimator.hpp).
+    double predicted_sensed{0.0};
   };
 
   // sample_time 0: the model's own. Throws std::invalid_argument naming the reason if the

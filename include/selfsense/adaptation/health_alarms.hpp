@@ -6,12 +6,14 @@
 // An alarm is raised by the first evaluation beyond its band and stays latched, with the time
 // it was first raised, until reset() at a moment its figure is back inside the band. Whether an
 // alarm is a warning or a fault is the caller's (HealthBands::fault).
-// Real-time safe: evaluate() and reset() are noexcept and allocation-free.
+// Real-time safe: evaluate(), reset() and the state's save and restore are noexcept and
+// allocation-free.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -54,6 +56,12 @@ class HealthAlarms final {
   }
   // Clears the latched alarms that are not active; returns those still latched.
   std::uint32_t reset() noexcept;
+  // The latched alarms and when each was raised (4 values: the latched bits, then raised_at_s
+  // per alarm), so that a restart keeps the warnings; the active bits are evaluated anew. A
+  // span shorter than kStateSize is left alone / ignored.
+  static constexpr std::size_t kStateSize{1 + kHealthAlarmCount};
+  void save_state(std::span<double> out) const noexcept;
+  void restore_state(std::span<const double> in) noexcept;
   [[nodiscard]] const HealthBands& bands() const noexcept { return bands_; }
 
  private:

@@ -20,17 +20,25 @@
 // Loss of polarisation: once cycles with the same field extremes (within span_tolerance of the
 // span) have run for settle_s (the creep settles after the drive starts or changes), the next
 // baseline_cycles set the baseline (C_b, W_b, E_min,b, E_max,b), the stack as new.
-// A later cycle with the baseline's extremes (again within span_tolerance) is compared with it;
-// the capacitance's change is read as a temperature rise and the loop's expected change at that
-// temperature is taken out:
+// A later cycle is compared with it; the capacitance's change is read as a temperature rise
+// and the loop's expected change at that temperature is taken out:
 //   rise = (C / C_b - 1) / capacitance_per_k                                       [K]
-//   loss = (1 - (W / W_b) / (1 + dissipation_per_k rise)) / depolarisation_sensitivity   [1]
+//   loss = (1 - rho / (1 + dissipation_per_k rise)) / depolarisation_sensitivity   [1]
+// with rho the loop's change against the baseline for the same drive:
+//   rho = (W / W_p) / (W_b / W_p,b)   model_reference, with the model's prediction: W_p is the
+//                                     loop area of the predicted D (the `predicted` input: the
+//                                     model's D for the measured field path, as identified) over
+//                                     the same samples, so a cycle is compared whatever its
+//                                     extremes, once its span is within max_span_change of the
+//                                     baseline's (a closed position loop raises the field as
+//                                     the stack ages: docs/health.md)
+//   rho = W / W_b                     otherwise, only a cycle with the baseline's extremes
+//                                     (within span_tolerance)
 // Warming raises C and narrows the loop; losing polarisation narrows the loop alone on a free
 // stack (sensitivity 1). On a load spring the stress follows the field and takes part of the
 // reversal slope (about -d^2 k_load / (1 + r)), which shrinks with the polarisation too, so the
 // compensated loop sees only part of the loss: the sensitivity is measured (docs/health.md). A
-// cycle with other extremes is measured (C, W) but not compared: the loop's area depends on the
-// drive.
+// cycle that is not compared is measured (C, W) all the same.
 //
 // Leakage: a hold is a run of samples whose field stays within hold_field_v_per_m of its first
 // sample. After hold_settle_s (the fast creep), each window of hold_window_s gives the slope of
@@ -50,6 +58,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 
@@ -75,11 +84,16 @@ struct HealthEstimatorConfig {
   // The compensated loop's relative change per relative loss of polarisation [1]: 1 on a free
   // stack whose loop area is all polarisation (header comment).
   double depolarisation_sensitivity{1.0};
+  // Compare each cycle's loop with the model's predicted loop for the same field path when the
+  // caller gives a prediction (header comment); cycles whose span differs from the baseline's
+  // by more than max_span_change (relative) are not compared.
+  bool model_reference{true};
+  double max_span_change{0.5};
 
   // Every value finite; fields, times positive (settle_s, hold_settle_s >= 0);
   // slope_time_s > trend_time_s; baseline_cycles
   // >= 1; span_tolerance in (0, 1); capacitance_per_k non-zero; depolarisation_sensitivity in
-  // (0, 2]. *why names the key under
+  // (0, 2]; max_span_change in (0, 1]. *why names the key under
   // `prefix` ("health.trend_time_s: must be > 0").
   [[nodiscard]] bool is_valid(const std::string& prefix, std::string* why) const;
   friend bool operator==(const HealthEstimatorConfig&, const HealthEstimatorConfig&) = default;
@@ -113,8 +127,13 @@ class HealthEstimator final {
   // non-positive sample time.
   HealthEstimator(const HealthEstimatorConfig& config, double sample_time_s);
 
-  // One sample; returns true when it completed a cycle.
-  bool step(double field, double sensed, bool accepted) noexcept;
+  // One sample; returns true when it completed a cycle. predicted: the model's D [C/m^2] for
+  // the field path (NaN: none; the cycles are then compared at the baseline's extremes only).
+  bool step(double field, double sensed, double predicted, bool accepted) noexcept;
+  bool step(double field, double sensed, bool accepted) noexcept {
+    return step(field, sensed, kNoPrediction, accepted);
+  }
+  static constexpr double kNoPrediction{std::numeric_limits<double>::quiet_NaN()};
 
   [[nodiscard]] HealthFigures figures() const noexcept;
   [[nodiscard]] const TrendFilter& capacitance() const noexcept { return capacitance_; }
@@ -125,15 +144,16 @@ class HealthEstimator final {
   [[nodiscard]] double time_s() const noexcept;
 
   // The learned baseline, trends and counts (the cycle and hold in progress start anew).
-  static constexpr std::size_t kStateSize{11 + 4 * TrendFilter::kStateSize};
+  static constexpr std::size_t kStateSize{12 + 4 * TrendFilter::kStateSize};
   [[nodiscard]] static constexpr std::size_t state_size() noexcept { return kStateSize; }
   void save_state(std::span<double> out) const noexcept;
   void restore_state(std::span<const double> in) noexcept;
 
  private:
-  void follow_reversals(double e, double d) noexcept;
-  void on_reversal(bool at_minimum, double e, double d, double extreme_e, double c_rev) noexcept;
-  void finish_cycle(double e, double d) noexcept;
+  void follow_reversals(double e, double d, double p) noexcept;
+  void on_reversal(bool at_minimum, double e, double d, double p, double extreme_e,
+                   double c_rev) noexcept;
+  void finish_cycle(double e, double d, double p) noexcept;
   void follow_hold(double e, double d) noexcept;
   void drop() noexcept;
 
@@ -148,12 +168,15 @@ class HealthEstimator final {
   double extreme_d_{0.0};
   double last_e_{0.0};
   double last_d_{0.0};
+  double last_p_{0.0};  // the prediction
   // The cycle in progress.
   bool in_cycle_{false};
   bool top_seen_{false};
   double area_{0.0};
   double start_e_{0.0};
   double start_d_{0.0};
+  double area_p_{0.0};  // the predicted loop's area so far (NaN once a prediction is missing)
+  double start_p_{0.0};
   double cycle_min_e_{0.0};
   double cycle_max_e_{0.0};
   double cycle_c_sum_{0.0};
@@ -163,6 +186,7 @@ class HealthEstimator final {
   double base_n_{0.0};
   double base_c_{0.0};
   double base_w_{0.0};
+  double base_wp_{0.0};  // the predicted loop's; <= 0: no prediction in the baseline
   double base_min_{0.0};
   double base_max_{0.0};
   // The hold in progress and its window's sums.

@@ -116,6 +116,12 @@ class Daemon final {
   // at the next start, so a crash leaves none. What happened to it at start: "restored",
   // "none" (no file), "not restored: WHY", or "off" (no model_state configured).
   [[nodiscard]] const std::string& model_state_at_start() const noexcept { return state_at_start_; }
+  // The health estimate's state travels in the same file (its `health` key): "restored",
+  // "none" (no file, or one without it), "not restored: WHY" (the model's state was not
+  // restored, or its size differs), or "off" (health or model_state not configured).
+  [[nodiscard]] const std::string& health_state_at_start() const noexcept {
+    return health_at_start_;
+  }
   // Test hook for the watchdog: the loop stops making progress.
   void stall_loop(bool on) noexcept { runner_->stall(on); }
   void request_stop() noexcept { stop_requested_.store(true); }
@@ -128,6 +134,8 @@ class Daemon final {
       StateOf running,
       const std::function<models::RestoreResult(const models::SavedState&)>& restore);
   StateSaved save_model_state(const std::filesystem::path& path);
+  // The health state read with the model's, into the loop before it runs (health_at_start_).
+  void resume_health();
   void notify_status();
   void write_telemetry();
 
@@ -152,6 +160,9 @@ class Daemon final {
   models::SavedState state_buffer_{};      // sized for the running model
   StateOf state_of_{StateOf::kPlain};      // the running reconstruction (adaptation.enabled)
   std::string state_at_start_{"off"};
+  std::vector<double> health_buffer_{};  // Loop::health_state_size(); the loop writes it too
+  std::vector<double> health_read_{};    // the file's `health` values, until the loop takes them
+  std::string health_at_start_{"off"};
 };
 
 }  // namespace selfsense::daemon

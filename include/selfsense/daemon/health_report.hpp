@@ -7,7 +7,8 @@
 //   dissipation_j_per_m3, dissipation_change_per_h, baseline_ready, depolarisation_pct,
 //   depolarisation_pct_per_h, leakage_resistivity_ohm_m, leakage_conductivity_s_per_m,
 //   cycles, compared_cycles, holds (a figure not yet measured, or infinite, is null),
-//   alarms: {overheating|depolarisation|insulation: {active, latched, raised_at_s}}
+//   alarms: {overheating|depolarisation|insulation: {active, latched, raised_at_s}},
+//   state_at_start (the daemon's: restored, none, not restored: WHY, off)
 // Prometheus (only when enabled): selfsense_health_capacitance_farads_per_metre,
 //   _capacitance_change_per_hour, _dissipation_joules_per_cubic_metre,
 //   _dissipation_change_per_hour, _depolarisation_ratio, _depolarisation_change_per_hour,
@@ -16,6 +17,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <string_view>
 #include <vector>
 
 #include "selfsense/daemon/prometheus.hpp"
@@ -23,7 +25,9 @@
 
 namespace selfsense::daemon {
 
-[[nodiscard]] nlohmann::json health_json(const runtime::HealthStatus& health);
+// state_at_start (when not empty): the `state_at_start` member (Daemon::health_state_at_start).
+[[nodiscard]] nlohmann::json health_json(const runtime::HealthStatus& health,
+                                         std::string_view state_at_start = {});
 [[nodiscard]] std::vector<MetricFamily> health_metrics(const runtime::HealthStatus& health);
 
 }  // namespace selfsense::daemon

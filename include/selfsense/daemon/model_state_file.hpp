@@ -14,6 +14,9 @@
 //                                         # memory, then the learned drift); the daemon takes a
 //                                         # state only into the reconstruction that wrote it
 //   values: [v0, v1, ...]                 # %.17g: the doubles round-trip exactly
+//   health: [h0, h1, ...]                 # optional: the health estimate and its alarms
+//                                         # (runtime::Loop::save_health_state), when health
+//                                         # runs; absent in older files
 //   complete: true                        # last: a file cut anywhere is refused
 //
 // Not real-time code: it allocates, does file I/O and throws.
@@ -21,7 +24,9 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string_view>
+#include <vector>
 
 #include "selfsense/models/model_identity.hpp"
 
@@ -33,13 +38,16 @@ enum class StateOf : std::uint8_t { kPlain, kAdapted };
 
 // Writes beside `path` and renames over it, so a reader never sees half a file. Throws
 // std::runtime_error naming the path (also for a value that is not finite).
+// An empty `health` writes no health key.
 void write_model_state(const std::filesystem::path& path, const models::SavedState& state,
-                       StateOf of = StateOf::kPlain);
+                       StateOf of = StateOf::kPlain, std::span<const double> health = {});
 
 // Throws io::YamlError ("file:line: key: ...") on a malformed or cut file, a hash that is not
 // 16 hexadecimal digits or a value that is not finite.
-// *of (when not null) gets the `reconstruction` key (kPlain when absent).
+// *of (when not null) gets the `reconstruction` key (kPlain when absent); *health (when not
+// null) the `health` values (empty when absent).
 [[nodiscard]] models::SavedState read_model_state(const std::filesystem::path& path,
-                                                  StateOf* of = nullptr);
+                                                  StateOf* of = nullptr,
+                                                  std::vector<double>* health = nullptr);
 
 }  // namespace selfsense::daemon

@@ -120,6 +120,21 @@ struct AgingConfig {
   double start_s{0.0};                    // the stack ages from this plant time on [s]
 };
 
+// Self-heating (issue 24 item 4, docs/health.md): the stack's temperature rises over the input
+// temperature with the electrical power it takes, through a thermal resistance R_th and a time
+// constant tau (first order, exact for a power held over a sample):
+//   P[k]    = V (E[k] + E[k-1]) / 2 (D[k] - D[k-1]) / Ts        V = n A_el h       [W]
+//   rise[k] = rise[k-1] + (1 - exp(-Ts / tau)) (R_th P[k] - rise[k-1])               [K]
+// and the coefficients of sample k see input.temp_degc + rise[k-1]. Over a drive cycle the
+// reactive part of P cancels and its mean is the loop area times V times the drive frequency,
+// so the steady state is rise = R_th W V f; tau much longer than the period smooths the rest.
+// Off by default.
+struct HeatingConfig {
+  bool enabled{false};
+  double thermal_resistance_k_per_w{50.0};  // R_th, stack to ambient [K/W]
+  double time_constant_s{120.0};            // tau = R_th C_th [s]
+};
+
 // Stack and load as one mass-spring-damper:
 //   m x'' + c x' + (k_s + k_load) x = k_s L S_free + F_ext,   k_s = A_mech / (s^E L),
 // m = (k_s + k_load) / (2 pi resonance_hz)^2, c = 2 zeta sqrt((k_s + k_load) m).
@@ -210,6 +225,7 @@ struct PlantConfig {
   StressConfig stress{};
   TemperatureConfig temperature{};
   AgingConfig aging{};
+  HeatingConfig heating{};
   MechanicsConfig mechanics{};
   ChargeAmplifierConfig charge_amplifier{};
   AmplifierConfig amplifier{};

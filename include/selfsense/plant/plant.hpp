@@ -6,8 +6,9 @@
 //   1. amplifier:  u = Amp[E_cmd h]                         (range, slew, current limit)
 //   2. field:      E = u / h
 //   3. polarisation: p = Preisach[E]                         (hysteresis)
-//   4. free response, coefficients c(temp, T, t) at the input temperature, the stack stress T and
-//      the plant's age t (aging: AgingConfig):
+//   4. free response, coefficients c(temp, T, t) at the input temperature (plus the
+//      self-heating's rise, HeatingConfig), the stack stress T and the plant's age t (aging:
+//      AgingConfig):
 //        S_i = d(T) E + a_S(T) (p - p0),  S_free = S_i + Creep_S[S_i]
 //   5. mechanics:  x = MSD[x_eq(S_free)],  S = x / L,  T = (S - S_free) / s^E
 //      Steps 4-5 make T a function f of the T that the coefficients see; the plant solves
@@ -62,8 +63,8 @@ struct StepOutput {
   double u_v{0.0};
   double q_c{0.0};  // stack charge, relative to the charge at reset
   double x_m{0.0};
-  double f_n{0.0};  // force in the stack, T A_mech
-  double temp_degc{0.0};
+  double f_n{0.0};           // force in the stack, T A_mech
+  double temp_degc{0.0};     // the stack's: the input's plus the self-heating's rise
   double polarisation{0.0};  // Preisach output p
   double q_amp_c{0.0};       // charge amplifier output (leakage, offset), before delay and ADC
   double latency_s{0.0};     // > 0 for a late sample
@@ -91,7 +92,8 @@ class Plant final {
     double u_prev_v{0.0};
     double q_prev_c{0.0};
     double capacitance_est_f{0.0};
-    double q_leak_c{0.0};  // charge through the insulation leakage (AgingConfig)
+    double q_leak_c{0.0};        // charge through the insulation leakage (AgingConfig)
+    double heating_rise_k{0.0};  // self-heating over the input temperature (HeatingConfig)
     StepOutput last{};
   };
 
@@ -121,6 +123,7 @@ class Plant final {
   PlantConfig config_;
   Derived derived_{};
   double ts_{};
+  double heating_gain_{};  // 1 - exp(-Ts / tau) (HeatingConfig)
   std::unique_ptr<const EverettTable> everett_{};
   State state_{};
 };

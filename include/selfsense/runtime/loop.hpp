@@ -22,10 +22,20 @@
 //
 // Health (LoopConfig::health_enabled): the loop steps adaptation::HealthEstimator with the
 // measured E and D of every cycle (a sample with any fault cause in its cycle is passed as
-// rejected) and evaluates the alarm bands (adaptation::HealthAlarms) every status period, with
-// the adaptation's equivalent temperature when it runs. An alarm latches as a warning (status
-// `health`); with bands.fault it is also Fault::kHealth, a cause in every cycle while it is
-// beyond its band. kReset clears the warnings back inside their bands, in any state.
+// rejected) and, under adaptation, the model's predicted D for the same field path (the loop
+// the loss of polarisation is measured against; without adaptation none) and evaluates the alarm
+// bands (adaptation::HealthAlarms) every status period, with the adaptation's equivalent
+// temperature when it runs. An alarm latches as a warning (status `health`); with bands.fault it is
+// also Fault::kHealth, a cause in every cycle while it is beyond its band. Its state (the
+// estimator's, then the alarms' latches) is saved with the model's by kSaveState and restored by
+// restore_health_state() before the first cycle, so a restart keeps the baseline, the trends and
+// the latched warnings. kReset clears the warnings back inside their bands, in any state; a reset
+// it answers with a refusal changes nothing (not the supervisor, not a warning):
+//   faulted, a fault cause in the last cycle      kRefusedCause
+//   faulted, no cause                             kDone: faults and clearable warnings cleared
+//   not faulted, a warning back inside its band   kDone: those warnings cleared
+//   not faulted, warnings all beyond their bands  kRefusedCause
+//   not faulted, no warning latched               kRefusedState (nothing to reset)
 //
 // Threads: cycle() runs on the real-time thread only. submit(), take_answer(), take_retired()
 // and status() are for one control thread (single producer / single consumer rings), status()
@@ -36,6 +46,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
@@ -122,6 +133,17 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
   // Timing figures from the runner, published with the next snapshot.
   void set_timing(const StatusSnapshot& timing) noexcept;
 
+  // The health state: adaptation::HealthEstimator's, then adaptation::HealthAlarms' (latched
+  // bits and raise times). 0 when health is off.
+  static constexpr std::size_t kHealthStateSize{adaptation::HealthEstimator::kStateSize +
+                                                adaptation::HealthAlarms::kStateSize};
+  [[nodiscard]] std::size_t health_state_size() const noexcept {
+    return health_ ? kHealthStateSize : 0;
+  }
+  // Before the first cycle (the loop thread not yet running): false, nothing restored, when
+  // health is off or the span's size is not health_state_size(). The status shows it at once.
+  bool restore_health_state(std::span<const double> in) noexcept;
+
   [[nodiscard]] const Supervisor& supervisor() const noexcept { return supervisor_; }
   [[nodiscard]] const Controller& controller() const noexcept { return controller_; }
   [[nodiscard]] const LoopConfig& config() const noexcept { return config_; }
@@ -132,6 +154,7 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
        SampleSink* sink);
   void handle(const LoopCommand& c) noexcept;
   void answer(const LoopCommand& c, CommandResult r) noexcept;
+  [[nodiscard]] CommandResult reset() noexcept;
   [[nodiscard]] double safe_command() const noexcept;
   [[nodiscard]] double setpoint() noexcept;
   [[nodiscard]] models::Reconstruction::Estimate estimate(double e, double d) noexcept;
@@ -164,6 +187,7 @@ class Loop final {  // NOLINT(clang-analyzer-optin.performance.Padding): members
   double s_hat_{0.0};
   double t_hat_{0.0};
   bool estimate_valid_{false};
+  double predicted_d_{0.0};         // the adapted model's predicted D (health's reference), or NaN
   std::uint32_t active_causes_{0};  // faults seen in the current cycle
   // Ramped stop: the command it starts from, its length and the cycles left [cycles].
   double ramp_from_{0.0};

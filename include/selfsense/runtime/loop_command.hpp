@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 
 #include "selfsense/runtime/controller.hpp"
 #include "selfsense/runtime/loop_sample.hpp"
@@ -33,7 +34,9 @@ enum class CommandKind : std::uint8_t {
   kSwapModel,  // model and, when not null, feedforward (ownership passes to the loop; the
                // model takes the running one's memory); refused while armed
   kSaveState,  // state: the model's state is saved into it (sized by make_saved_state() for the
-               // running model); kInvalid when it does not fit
+               // running model); kInvalid when it does not fit. health_state, when not empty:
+               // the health estimate's and alarms' state too (Loop::health_state_size() values;
+               // kInvalid when the size differs)
   kAdapt,      // value: 1 freezes the drift estimate (adaptation/drift_estimator.hpp), 0
                // resumes learning; kInvalid when the loop runs no adaptation
   kRampDown,   // value: seconds; while armed, the command ramps linearly from its last value
@@ -52,6 +55,7 @@ struct LoopCommand {
   Tuning tuning{};
   Feedforward* feedforward{nullptr};   // kSwapModel: the controller's new inverse model
   models::SavedState* state{nullptr};  // kSaveState: owned by the sender, who waits for the answer
+  std::span<double> health_state{};    // kSaveState: likewise
 };
 
 enum class CommandResult : std::uint8_t {
