@@ -184,8 +184,8 @@ void describe_stress(Finding& f, const Evidence& e) {
   const std::string& tail = e.tail;
   const double pct = e.pct;
   if (c.stress_drive_per_pa != 0.0) {
-    // Each part of the sensed response with its own change per MPa, at the recording's mean
-    // drive magnitude: the permittivity's (T x), the whole response's (T r), the coupling's (T^2).
+    // Each part of the sensed response with its own change per MPa, the permittivity's (T x) at
+    // the recording's RMS drive, the whole response's (T r), the coupling's (T^2).
     double x_rms = 0.0;
     for (const double x : s.drive)
       x_rms += x * x / static_cast<double>(s.drive.size());
@@ -384,7 +384,8 @@ bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, boo
                 bool charge_drive) {
   if (ch.sensed ? !c.on_sensed : !c.on_strain) return false;
   const auto uses = [&](CorrectionTerm t) { return uses_term(c, t); };
-  // T^2 on the sensed channel is solved with the sensor coupling; leakage is a charge's.
+  // The terms in T on the sensed channel are solved with the sensor coupling; leakage is a
+  // charge's.
   if ((uses(CorrectionTerm::kStressQuadratic) || uses(CorrectionTerm::kStressDrive)) && ch.sensed &&
       ch.coupling == 0.0) {
     return false;

@@ -186,7 +186,8 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
       const Finding creep_found = creep->finding;
       search_again(*creep, {});
       // The leak beside the creep: judged with the creep's structure, where the rounds on it
-      // name nothing but creep.
+      // name nothing but creep, by its forecast alone (the structure's slowest lags take a slow
+      // leak in over the half they are fitted on; reidentified.hpp, ShownBy).
       if (leak_candidate && named_only("creep")) {
         models::TransducerModel with_creep = model;
         with_creep.structure = *creep->structure;

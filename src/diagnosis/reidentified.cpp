@@ -192,10 +192,10 @@ std::vector<Segment> where_it_changes(const std::vector<double>& output,
 namespace {
 
 // The forecast's judgement of `best` against `null` (both identified on the first half): it
-// must fit that half by min_explains better (the identification's own evidence: on clean stacks
-// a small effect mends the forecast of a model of another class a little; it does not change the
-// fit) and beat the null on the second half by the rules of a round. The share of the null's
-// error it removes there, or nullopt.
+// must (with ShownBy::kFitAndForecast) fit that half by min_explains better (the
+// identification's own evidence: on clean stacks a small effect mends the forecast of a model of
+// another class a little; it does not change the fit) and beat the null on the second half by
+// the rules of a round. The share of the null's error it removes there, or nullopt.
 std::optional<double> forecast_explains(const Trial& null, const Trial& best, const ChannelData& ch,
                                         std::size_t half, const Options& options,
                                         ShownBy evidence) {

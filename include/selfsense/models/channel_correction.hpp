@@ -42,11 +42,10 @@
 // channel's response to the drive alone (so a coupling that changes with stress,
 // d(T) = d (1 + k T), is k T r on S and d k T^2 on D). Units: gain, temperature_gain [1/K],
 // stress_gain [1/Pa] relative, stress_drive [channel unit / (drive unit Pa)], stress_linear
-// [channel unit / Pa], temperature_gain2
-// [1/K^2]; offset, drive_linear and the
-// polynomial terms in the channel's unit (per unit of the drive to its power); temperature_stress
-// [channel unit / (Pa K)], temperature_stress2 [channel unit / (Pa K^2)]; drive_integral in
-// the channel's unit per (drive unit s): for D under field drive the conductivity [S/m].
+// [channel unit / Pa], temperature_gain2 [1/K^2]; offset, drive_linear and the polynomial terms
+// in the channel's unit (per unit of the drive to its power); temperature_stress [channel unit /
+// (Pa K)], temperature_stress2 [channel unit / (Pa K^2)]; drive_integral in the channel's unit per
+// (drive unit s): for D under field drive the conductivity [S/m].
 //
 // Reconstruction needs the inverse on the sensed channel: the leakage is undone
 // (w[k] = w[k-1] + (m[k] - g m[k-1]) / c), a delay moves to the drive, and the additive and
