@@ -209,6 +209,12 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
         search_again(*beside, {leak_found});
       }
     }
+    // Neither alone: the pair as one forecast (reidentified.hpp, CreepAndLeak).
+    if (creep_candidate && leak_candidate && !creep && !leak) {
+      const std::optional<CreepAndLeak> pair =
+          reidentified_creep_and_leak(model, s, ch, model_output, options);
+      if (pair) search_again(pair->reidentified, {pair->leak});
+    }
     // A channel sampled late bends the base the same way (its fastest lags follow the lag, so a
     // delay fitted after it wins on fast blocks and loses on slow ones): where a lag explained
     // min_explains of the held-out residual in the first round and the rounds named nothing

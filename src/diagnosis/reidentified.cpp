@@ -296,6 +296,59 @@ std::string lags_of(const models::SideModel& side) {
          format("%.2g s", 1.0 / *lo);
 }
 
+constexpr models::Structure kWithCreep = models::Structure::kHysteresisCreep;
+
+// The leak of the grid (coarse_leaks, then the best one's neighbours at a factor sqrt(3)) that
+// fits the first half best with this judge's structure.
+Trial best_leak(const Judge& judge, const Signals& s) {
+  Trial best;
+  for (const models::ChannelCorrection& effect : coarse_leaks(s)) {
+    Trial t = judge.trial(effect);
+    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
+  }
+  if (best.forecast.empty()) return best;
+  for (const double factor : {std::sqrt(3.0), 1.0 / std::sqrt(3.0)}) {
+    Trial t = judge.trial(scaled(best.effect, factor));
+    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
+  }
+  return best;
+}
+
+// The leak's candidate, terms and finding on a re-identified side that carries it.
+void as_leak(Reidentified& r, const ChannelData& ch, const Signals& s,
+             const std::vector<double>& current, const std::string& judged) {
+  const models::ChannelCorrection& leak = r.correction;
+  const CorrectionTerm term =
+      leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage : CorrectionTerm::kDriveIntegral;
+  r.candidate = &candidate_using(term);
+  r.terms = {term};
+  r.finding.effect = "charge_leakage";
+  r.finding.where = where_it_changes(r.output, current);
+  describe(r.finding, *r.candidate, leak, ch, s, current, r.output, judged);
+}
+
+// The creep finding of a side re-identified with creep operators.
+void as_creep(Reidentified& r, const ChannelData& ch, const Signals& s,
+              const std::vector<double>& current, std::size_t half) {
+  r.structure = kWithCreep;
+  r.candidate = &candidate_using(CorrectionTerm::kCreep);
+  Finding& f = r.finding;
+  f.effect = r.candidate->effect;
+  f.where = where_it_changes(r.output, current);
+  f.evidence = "after steps of the drive the recorded " + ch.name +
+               " keeps moving, as creep operators draw it (the model's structure with them, " +
+               std::string(models::to_string(kWithCreep)) + ": " + lags_of(r.side) +
+               format("); modelled, it removes %.0f %% of the residual variance on the last ",
+                      100.0 * f.explains) +
+               format(
+                   "%.3g s of the recording as a forecast (the structure with creep operators "
+                   "identified on the first half, against the same structure without them: the "
+                   "model had bent its loop to the creep)",
+                   static_cast<double>(s.drive.size() - half) * s.sample_time);
+  f.feature_name = "log10 time since the drive last stepped [s]";
+  f.feature = log_time_since_step(s.drive, s.sample_time);
+}
+
 }  // namespace
 
 std::optional<Reidentified> reidentified_leak(const models::TransducerModel& model,
@@ -310,15 +363,7 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
   };
   std::optional<Reidentified> r =
       judged_as_forecast(judge, ch, coarse_leaks(s), neighbours, options, evidence);
-  if (!r) return std::nullopt;
-  const models::ChannelCorrection& leak = r->correction;
-  r->candidate = &candidate_using(leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage
-                                                           : CorrectionTerm::kDriveIntegral);
-  r->terms = {leak.leakage_tau_s > 0.0 ? CorrectionTerm::kLeakage : CorrectionTerm::kDriveIntegral};
-  r->finding.effect = "charge_leakage";
-  r->finding.where = where_it_changes(r->output, current);
-  describe(r->finding, *r->candidate, leak, ch, s, current, r->output,
-           as_forecast(judge, s, ch, "leak"));
+  if (r) as_leak(*r, ch, s, current, as_forecast(judge, s, ch, "leak"));
   return r;
 }
 
@@ -366,7 +411,6 @@ std::optional<Reidentified> reidentified_creep(const models::TransducerModel& mo
   if (model.structure != models::Structure::kHysteresis || !reidentifiable(model, s, ch)) {
     return std::nullopt;
   }
-  constexpr models::Structure kWithCreep = models::Structure::kHysteresisCreep;
   const Judge as_is(model, s, ch);
   const Judge with_creep(s, ch, kWithCreep);
   const Trial null = as_is.trial(beside);
@@ -377,24 +421,47 @@ std::optional<Reidentified> reidentified_creep(const models::TransducerModel& mo
   std::optional<Reidentified> r = identified_whole(with_creep, beside, ch, *explains);
   if (!r) return std::nullopt;
   r->fit_explains = 1.0 - creep.first_half_sse / null.first_half_sse;
-  r->structure = kWithCreep;
-  r->candidate = &candidate_using(CorrectionTerm::kCreep);
-  Finding& f = r->finding;
-  f.effect = r->candidate->effect;
-  f.where = where_it_changes(r->output, current);
-  f.evidence = "after steps of the drive the recorded " + ch.name +
-               " keeps moving, as creep operators draw it (the model's structure with them, " +
-               std::string(models::to_string(kWithCreep)) + ": " + lags_of(r->side) +
-               format("); modelled, it removes %.0f %% of the residual variance on the last ",
-                      100.0 * *explains) +
-               format(
-                   "%.3g s of the recording as a forecast (the structure with creep operators "
-                   "identified on the first half, against the same structure without them: the "
-                   "model had bent its loop to the creep)",
-                   static_cast<double>(s.drive.size() - as_is.half()) * s.sample_time);
-  f.feature_name = "log10 time since the drive last stepped [s]";
-  f.feature = log_time_since_step(s.drive, s.sample_time);
+  as_creep(*r, ch, s, current, as_is.half());
   return r;
+}
+
+std::optional<CreepAndLeak> reidentified_creep_and_leak(const models::TransducerModel& model,
+                                                        const Signals& s, const ChannelData& ch,
+                                                        const std::vector<double>& current,
+                                                        const Options& options) {
+  if (model.structure != models::Structure::kHysteresis || !ch.sensed ||
+      !reidentifiable(model, s, ch)) {
+    return std::nullopt;
+  }
+  const Judge as_is(model, s, ch);
+  const Judge with_creep(s, ch, kWithCreep);
+  const Trial null = as_is.trial(models::ChannelCorrection{});
+  const Trial pair = best_leak(with_creep, s);
+  const std::optional<double> explains =
+      forecast_explains(null, pair, ch, as_is.half(), options, ShownBy::kFitAndForecast);
+  if (!explains) return std::nullopt;
+  // Each part must carry the forecast: the pair beats the creep structure alone and the model's
+  // structure with its own best leak.
+  const Trial creep = with_creep.trial(models::ChannelCorrection{});
+  const Trial leak = best_leak(as_is, s);
+  if (!forecast_explains(creep, pair, ch, as_is.half(), options, ShownBy::kForecast) ||
+      !forecast_explains(leak, pair, ch, as_is.half(), options, ShownBy::kForecast)) {
+    return std::nullopt;
+  }
+  std::optional<Reidentified> r = identified_whole(with_creep, pair.effect, ch, *explains);
+  if (!r) return std::nullopt;
+  r->fit_explains = 1.0 - pair.first_half_sse / null.first_half_sse;
+  as_creep(*r, ch, s, current, as_is.half());
+  CreepAndLeak out{*r, {}};
+  as_leak(out.reidentified, ch, s, current,
+          format("on the last %.3g s of the recording as a forecast (the structure with creep "
+                 "operators identified on the first half with the leak undone, against it without "
+                 "the leak and the model's structure with its own best leak: each alone had bent "
+                 "its operators to the other's drift)",
+                 static_cast<double>(s.drive.size() - as_is.half()) * s.sample_time));
+  out.leak = out.reidentified.finding;
+  out.reidentified.finding = r->finding;
+  return out;
 }
 
 }  // namespace selfsense::diagnosis::detail

@@ -90,6 +90,26 @@ enum class ShownBy : std::uint8_t { kFitAndForecast, kForecast };
     const std::vector<double>& current, const Options& options,
     const models::ChannelCorrection& beside = {});
 
+// Creep and a leak on the sensed channel judged as one forecast, where neither alone was named:
+// each alone leaves the other's drift to extrapolate (a creep structure fitted beside an
+// unmodelled leak bends its slowest lags to it, a leak fitted beside unmodelled creep takes the
+// creep's settling in), so each forecast fails though the pair would not. The candidate is the
+// structure with creep operators identified on the first half with each leak of reidentified_leak's
+// grid undone (the leak chosen on that half's fit). It must beat the null (the model's structure,
+// no leak) as reidentified_creep's candidate does, and each part must carry the forecast: the
+// pair beats the creep structure alone and the model's structure with its own best leak by
+// forecast_explains (ShownBy::kForecast). `reidentified` carries the creep finding, the side,
+// and the leak as its correction (its candidate and terms the leak's); `leak` is the leak's
+// finding.
+struct CreepAndLeak {
+  Reidentified reidentified{};
+  Finding leak{};
+};
+
+[[nodiscard]] std::optional<CreepAndLeak> reidentified_creep_and_leak(
+    const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
+    const std::vector<double>& current, const Options& options);
+
 // Stress dependence judged by re-identification with the stress-hysteresis structure
 // (docs/diagnose.md, "Stress dependence re-identified"): a stack whose permittivity, coupling
 // and loop size move with the stress bends an affine base to it, and no correction after it
