@@ -75,7 +75,6 @@ Loop::Loop(const LoopConfig& config, Driver& driver,
            SampleSink* sink)
     : Loop(config, driver, nullptr, std::move(model), controller, sink) {
   if (!adapted_) throw std::invalid_argument("loop: needs a model");
-  publish_adaptation();
 }
 
 Loop::Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Reconstruction> model,
@@ -102,6 +101,12 @@ Loop::Loop(const LoopConfig& config, Driver& driver, std::unique_ptr<models::Rec
     status_.health.fault = config_.health_bands.fault;
     status_.health.raised_at_s.fill(-1.0);
   }
+  // The first snapshot, from the configuration: until the loop's first status period, a
+  // status request sees the adaptation and health that are configured (figures not yet
+  // measured), not a default that says they are off.
+  publish_adaptation();
+  publish_health();
+  published_.publish(status_);
 }
 
 // Whatever the control thread did not collect is freed here (never on the loop thread).

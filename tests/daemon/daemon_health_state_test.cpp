@@ -67,6 +67,8 @@ TEST(DaemonHealthState, ARestartResumesTheBaselineTrendsAndLatchedWarnings) {
   nlohmann::json before;
   {
     const auto daemon = start();
+    // Configured: on from the first answer, whether or not the loop has published yet.
+    EXPECT_TRUE(daemon->status()["health"].value("enabled", false));
     EXPECT_EQ(published_health(*daemon)["state_at_start"], "none");
     play_sine(*daemon);
     for (int i = 0; i < 100; ++i) {

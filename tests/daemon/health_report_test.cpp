@@ -50,6 +50,23 @@ TEST(HealthReport, StatusJsonNamesEveryFigureAndAlarm) {
   EXPECT_TRUE(j.at("alarms").contains("insulation"));
 }
 
+// Configured but nothing measured yet (the loop's snapshot before its first cycle): enabled,
+// every figure null, no alarm raised.
+TEST(HealthReport, ConfiguredButNotYetMeasuredReportsNullFigures) {
+  runtime::HealthStatus h;
+  h.enabled = true;
+  h.raised_at_s.fill(-1.0);
+  const nlohmann::json j = health_json(h);
+  EXPECT_EQ(j.at("enabled"), true);
+  for (const char* key : {"capacitance_f_per_m", "dissipation_j_per_m3", "depolarisation_pct",
+                          "leakage_resistivity_ohm_m"}) {
+    EXPECT_TRUE(j.at(key).is_null()) << key;
+  }
+  EXPECT_EQ(j.at("cycles"), 0);
+  EXPECT_EQ(j.at("baseline_ready"), false);
+  EXPECT_TRUE(j.at("alarms").at("overheating").at("raised_at_s").is_null());
+}
+
 TEST(HealthReport, PrometheusFamiliesAreValidExposition) {
   EXPECT_TRUE(health_metrics(runtime::HealthStatus{}).empty());
   runtime::HealthStatus h = measured();

@@ -40,6 +40,26 @@ std::vector<double> save(HealthBench& b, CommandResult expected = CommandResult:
   return health;
 }
 
+// Before the loop's first cycle (the daemon's socket may answer then) the status says what is
+// configured: health and adaptation on, nothing measured yet, no alarm. It used to be the
+// default snapshot, which said health and adaptation were off.
+TEST(LoopHealthState, BeforeTheFirstCycleTheStatusSaysWhatIsConfigured) {
+  const HealthBench b(options());
+  const StatusSnapshot s = b.loop->status();
+  EXPECT_EQ(s.cycle, 0);
+  EXPECT_TRUE(s.adaptation.enabled);
+  EXPECT_EQ(s.adaptation.updates, 0U);
+  EXPECT_TRUE(s.health.enabled);
+  EXPECT_FALSE(s.health.fault);
+  const adaptation::HealthFigures& f = s.health.figures;
+  EXPECT_FALSE(f.has_capacitance || f.has_dissipation || f.has_depolarisation || f.has_leakage);
+  EXPECT_FALSE(f.baseline_ready);
+  EXPECT_EQ(f.cycles + f.compared_cycles + f.holds, 0U);
+  EXPECT_EQ(s.health.active | s.health.latched, 0U);
+  for (const double t : s.health.raised_at_s)
+    EXPECT_LT(t, 0.0);
+}
+
 TEST(LoopHealthState, SavedAndRestoredIntoANewLoopBitForBit) {
   HealthBench first(options());
   first.run(0.1);
