@@ -543,7 +543,7 @@ TEST(Loop, WithinCountZeroFaultsOnlyOnAStall) {
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kFaulted);
   EXPECT_NE(b.loop->supervisor().latched() & bit(Fault::kOverrun), 0U);
   EXPECT_FALSE((OverrunPolicy{2000, 65, 100}.is_valid(&why)));
-  EXPECT_EQ(why, "safety.overrun.within_count: must be in [0, 64]");
+  EXPECT_EQ(why, "safety.overrun.within_count: 65 must be within [0, 64]");
 }
 
 // A wave that ended or was stopped after playing longer than the watchdog used to fault in the
