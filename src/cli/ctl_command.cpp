@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "ctl_table.hpp"
 #include "selfsense/daemon/control_client.hpp"
 #include "selfsense/daemon/control_protocol.hpp"
+#include "selfsense/importers/table_values.hpp"
 
 namespace selfsense::cli {
 namespace {
@@ -83,9 +83,9 @@ nlohmann::json wave_request(const WaveOptions& wave) {
     if (member == "frequency_hz") request[member] = wave.frequency;
     if (member == "phase") request[member] = wave.phase;
     if (member == "repeat") request[member] = wave.repeat;
-    if (member == "levels") request[member] = parse_number_list(wave.levels, "--levels");
+    if (member == "levels") request[member] = importers::parse_number_list(wave.levels, "--levels");
     if (member == "dwell_s") request[member] = wave.dwell;
-    if (member == "values") request[member] = read_table_values(wave.table);
+    if (member == "values") request[member] = importers::read_table_values(wave.table);
     if (member == "dt_s") request[member] = wave.dt;
   }
   return request;

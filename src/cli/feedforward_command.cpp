@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "field_signals.hpp"
 #include "selfsense/base/format_number.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/model_io/model_yaml.hpp"

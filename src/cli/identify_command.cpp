@@ -16,14 +16,23 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "field_signals.hpp"
-#include "model_runs.hpp"
+#include "selfsense/evaluation/field_signals.hpp"
+#include "selfsense/evaluation/model_runs.hpp"
 #include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/io/recording.hpp"
-#include "selfsense/io/yaml_map.hpp"
+#include "selfsense/model_io/geometry_yaml.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 
 namespace selfsense::cli {
+
+using evaluation::ChannelFigures;
+using evaluation::describe;
+using evaluation::field_signals;
+using evaluation::FieldSignals;
+using evaluation::figures;
+using evaluation::ModelRuns;
+using evaluation::run_model;
+using evaluation::to_json;
 namespace {
 
 struct IdentifyOptions {
@@ -43,20 +52,6 @@ struct IdentifyOptions {
   double fastest{0.0};
   double slowest{0.0};
 };
-
-models::Geometry load_geometry(const std::filesystem::path& path) {
-  io::YamlMap g = io::YamlMap::load_file(path);
-  models::Geometry geo;
-  geo.layer_thickness = g.required<double>("layer_thickness_m");
-  geo.electrode_area = g.required<double>("electrode_area_m2");
-  geo.layers = g.required<double>("layers");
-  geo.active_length = g.required<double>("active_length_m");
-  geo.cross_section = g.required<double>("cross_section_m2");
-  g.finish();
-  std::string why;
-  if (!geo.is_valid(&why)) throw io::YamlError(g.locate(why.substr(why.find('.') + 1)));
-  return geo;
-}
 
 void print_table(const std::vector<ChannelFigures>& fit, const std::vector<ChannelFigures>& held) {
   std::printf("  channel   fit nrmse   fit max   held-out nrmse   held-out max\n");
@@ -96,7 +91,7 @@ void run_identify(const IdentifyOptions& opt) {
                                 models::structure_names());
   }
   std::optional<models::Geometry> geometry;
-  if (!opt.geometry.empty()) geometry = load_geometry(opt.geometry);
+  if (!opt.geometry.empty()) geometry = models::load_geometry(opt.geometry);
   const io::Recording rec = io::read_recording_csv(opt.recording, io::ReadOptions{{"t"}});
   const FieldSignals signals =
       field_signals(rec, opt.recording.string(), geometry, models::drive_of(*structure));

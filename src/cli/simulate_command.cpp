@@ -12,16 +12,23 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "field_signals.hpp"
-#include "model_runs.hpp"
-#include "selfsense/adaptation/adapted_reconstruction.hpp"
 #include "selfsense/base/format_number.hpp"
+#include "selfsense/evaluation/field_signals.hpp"
+#include "selfsense/evaluation/model_runs.hpp"
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
-#include "selfsense/operators/parameter_error.hpp"
 
 namespace selfsense::cli {
+
+using evaluation::AdaptedRuns;
+using evaluation::can_reconstruct;
+using evaluation::describe;
+using evaluation::field_signals;
+using evaluation::FieldSignals;
+using evaluation::ModelRuns;
+using evaluation::run_adapted;
+using evaluation::run_model;
 namespace {
 
 struct RunOptions {
@@ -32,43 +39,22 @@ struct RunOptions {
   std::string temperature_column{};  // reconstruct: the recorded temperature [degC] to use
 };
 
-// `reconstruct --adapt`: the adapted reconstruction over the recording, with the equivalent
-// temperature (temp_equivalent [degC]) and the permittivity drift (permittivity_drift [1])
-// beside T_hat and S_hat. With a temperature column the drift follows that temperature instead.
-void run_adapted(const models::TransducerModel& model, const FieldSignals& signals,
-                 const std::vector<double>& temperature, io::Recording& rec) {
-  adaptation::DriftEstimatorConfig config{};
-  config.frozen = !temperature.empty();
-  adaptation::AdaptedReconstruction adapted(model, config, signals.sample_time);
-  const std::span<const double> x = signals.drive(model.drive());
-  const std::span<const double> y = signals.sensed(model.drive());
-  const std::size_t n = signals.size();
-  std::vector<double> t_hat(n);
-  std::vector<double> s_hat(adapted.has_strain() ? n : 0);
-  std::vector<double> status(n);
-  std::vector<double> equivalent(n);
-  std::vector<double> permittivity(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    if (!temperature.empty()) adapted.set_temperature(temperature[k]);
-    const adaptation::AdaptedReconstruction::Estimate est = adapted.step(x[k], y[k]);
-    t_hat[k] = est.stress;
-    if (!s_hat.empty()) s_hat[k] = est.strain;
-    status[k] = static_cast<double>(est.status);
-    equivalent[k] = adapted.drift().temperature_degc;
-    permittivity[k] = adapted.drift().permittivity;
-  }
-  rec.set_column("T_hat", std::move(t_hat));
-  if (!s_hat.empty()) rec.set_column("S_hat", std::move(s_hat));
-  rec.set_column("estimate_status", std::move(status));
-  rec.set_column("temp_equivalent", std::move(equivalent));
-  rec.set_column("permittivity_drift", std::move(permittivity));
-  const adaptation::Drift last = adapted.drift();
+// `reconstruct --adapt`: T_hat and S_hat with the equivalent temperature (temp_equivalent
+// [degC]) and the permittivity drift (permittivity_drift [1]) beside them.
+void write_adapted(const models::TransducerModel& model, const FieldSignals& signals,
+                   const std::vector<double>& temperature, io::Recording& rec) {
+  AdaptedRuns runs = run_adapted(model, signals, temperature);
+  rec.set_column("T_hat", std::move(runs.stress_hat));
+  if (!runs.strain_hat.empty()) rec.set_column("S_hat", std::move(runs.strain_hat));
+  rec.set_column("estimate_status", std::move(runs.estimate_status));
+  rec.set_column("temp_equivalent", std::move(runs.temp_equivalent));
+  rec.set_column("permittivity_drift", std::move(runs.permittivity_drift));
   std::printf(
       "adaptation: %zu updates; at the end permittivity %+.3f %%, loop %+.3f %%, "
       "equivalent temperature %.2f degC%s\n",
-      adapted.estimator().updates(), 100.0 * last.permittivity, 100.0 * last.loop,
-      last.temperature_degc, temperature.empty() ? "" : " (from the recorded temperature)");
-  std::printf("samples: %s\n", describe(adapted.counts()).c_str());
+      runs.updates, 100.0 * runs.last.permittivity, 100.0 * runs.last.loop,
+      runs.last.temperature_degc, temperature.empty() ? "" : " (from the recorded temperature)");
+  std::printf("samples: %s\n", describe(runs.counts).c_str());
 }
 
 // Says what a user must know about the run: the rate it ran at and every rejected sample.
@@ -129,7 +115,7 @@ void run(const RunOptions& opt, bool reconstruct) {
                                "stress coupling: identify it from a recording with T or F)");
     }
     if (opt.adapt) {
-      run_adapted(model, signals, temperature, rec);
+      write_adapted(model, signals, temperature, rec);
     } else {
       const ModelRuns runs = run_model(model, signals, false, true);
       rec.set_column("T_hat", runs.stress_hat);

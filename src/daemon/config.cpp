@@ -6,6 +6,8 @@
 #include <string_view>
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
+#include "selfsense/base/check.hpp"
+#include "selfsense/base/format_number.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
 
 namespace selfsense::daemon {
@@ -23,21 +25,16 @@ class Problems {
   void check(bool ok, const std::string& key, const std::string& message) {
     if (!ok) add(key + ": " + message);
   }
+  // base::check's message: "<key>: <value> <constraint>".
+  template <typename T>
+  void require(bool ok, const std::string& key, T value, std::string_view constraint) {
+    if (!ok) add(base::check::violation(key, value, constraint));
+  }
 
  private:
   const YamlMap* root_;
   std::vector<std::string>* out_;
 };
-
-std::string number(double x) {
-  std::string s = std::to_string(x);
-  while (s.find('.') != std::string::npos && (s.back() == '0' || s.back() == '.')) {
-    const bool dot = s.back() == '.';
-    s.pop_back();
-    if (dot) break;
-  }
-  return s;
-}
 
 // YAML integers arrive as 64 bits; the fields are 32.
 void read_u32(YamlMap& map, std::string_view key, std::uint32_t& out) {
@@ -236,15 +233,13 @@ void read_health(YamlMap h, HealthSection& out) {
 // Value and cross-field rules, every problem collected.
 void validate(const DaemonConfig& c, Problems& p) {
   const double fs = c.loop.rate_hz;
-  p.check(fs >= 100.0 && fs <= 100000.0, "loop.rate_hz",
-          number(fs) + " must be within [100, 100000]");
-  p.check(c.loop.priority >= 1 && c.loop.priority <= 99, "loop.priority",
-          std::to_string(c.loop.priority) + " must be within [1, 99] (SCHED_FIFO)");
+  p.require(fs >= 100.0 && fs <= 100000.0, "loop.rate_hz", fs, "must be within [100, 100000]");
+  p.require(c.loop.priority >= 1 && c.loop.priority <= 99, "loop.priority", c.loop.priority,
+            "must be within [1, 99] (SCHED_FIFO)");
   p.check(c.loop.cpu >= -1, "loop.cpu", "must be -1 (any) or a CPU index");
-  p.check(c.loop.cpu_dma_latency_us >= -1 && c.loop.cpu_dma_latency_us <= 1000000,
-          "loop.cpu_dma_latency_us",
-          std::to_string(c.loop.cpu_dma_latency_us) +
-              " must be -1 (no request) or within [0, 1000000]");
+  p.require(c.loop.cpu_dma_latency_us >= -1 && c.loop.cpu_dma_latency_us <= 1000000,
+            "loop.cpu_dma_latency_us", c.loop.cpu_dma_latency_us,
+            "must be -1 (no request) or within [0, 1000000]");
   p.check(c.loop.status_period_cycles >= 1, "loop.status_period_cycles", "must be >= 1");
   if (!(fs > 0.0)) return;
   const double ts = 1.0 / fs;
@@ -264,8 +259,8 @@ void validate(const DaemonConfig& c, Problems& p) {
     const FilterSection& f = c.filters[i];
     const std::string key = "control.filters[" + std::to_string(i) + "]";
     if (f.frequency_hz >= 0.45 * fs) {
-      p.add(key + ".frequency_hz: " + number(f.frequency_hz) +
-            " Hz must be below 0.45 of the loop rate (" + number(0.45 * fs) + " Hz)");
+      p.add(key + ".frequency_hz: " + base::format_number(f.frequency_hz) +
+            " Hz must be below 0.45 of the loop rate (" + base::format_number(0.45 * fs) + " Hz)");
     }
   }
   if (c.filters.size() > control::FilterChain::kMaxSections) {
@@ -286,8 +281,8 @@ void validate(const DaemonConfig& c, Problems& p) {
           "safety.safe_value_v_per_m", "must be inside control.command_v_per_m");
   if (!s.overrun.is_valid(&why)) p.add(why);
   p.check(s.watchdog_s >= 0.0, "safety.watchdog_s", "must be >= 0");
-  p.check(s.stop_ramp_s >= 0.0 && s.stop_ramp_s <= 10.0, "safety.stop_ramp_s",
-          number(s.stop_ramp_s) + " must be within [0, 10] s");
+  p.require(s.stop_ramp_s >= 0.0 && s.stop_ramp_s <= 10.0, "safety.stop_ramp_s", s.stop_ramp_s,
+            "must be within [0, 10] s");
   const RecorderSection& r = c.recorder;
   p.check(r.rotate_bytes >= 4096, "recorder.rotate_bytes", "must be >= 4096");
   p.check(r.flush_ms >= 1.0 && r.flush_ms <= 60000.0, "recorder.flush_ms",

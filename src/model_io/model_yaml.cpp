@@ -12,6 +12,7 @@
 #include <string_view>
 #include <utility>
 
+#include "geometry_fields.hpp"
 #include "selfsense/io/yaml_map.hpp"
 
 namespace selfsense::models {
@@ -220,13 +221,7 @@ TransducerModel read_model(YamlMap root) {
   model.sample_time = root.required<double>("sample_time_s");
   if (!(model.sample_time > 0.0)) root.fail("sample_time_s", "must be > 0");
   if (auto g = root.optional_map("geometry")) {
-    Geometry geo;
-    geo.layer_thickness = g->required<double>("layer_thickness_m");
-    geo.electrode_area = g->required<double>("electrode_area_m2");
-    geo.layers = g->required<double>("layers");
-    geo.active_length = g->required<double>("active_length_m");
-    geo.cross_section = g->required<double>("cross_section_m2");
-    g->finish();
+    const Geometry geo = read_geometry_fields(*g);
     std::string why;
     if (!geo.is_valid(&why)) throw io::YamlError(root.locate(why));
     model.geometry = geo;

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "selfsense/base/check.hpp"
+
 namespace selfsense::runtime {
 namespace {
 
@@ -42,21 +44,22 @@ Fault fault_of(models::SampleStatus s) noexcept {
 }  // namespace
 
 bool LoopConfig::is_valid(std::string* why) const {
-  const auto fail = [why](const char* message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
+  namespace check = base::check;
   if (!(sample_time >= 1.0 / 100000.0 && sample_time <= 1.0 / 100.0)) {
-    return fail("loop.rate_hz: must be within [100, 100000]");
+    return check::fail("loop.rate_hz", "must be within [100, 100000]", why);
   }
-  if (!std::isfinite(safe_value)) return fail("safety.safe_value: must be finite");
-  if (!(strain_min < strain_max)) return fail("safety.strain_range: min must be < max");
-  if (!(stress_min < stress_max)) return fail("safety.stress_range: min must be < max");
-  if (!(watchdog_s >= 0.0 && std::isfinite(watchdog_s))) {
-    return fail("safety.watchdog_s: must be finite and >= 0");
+  if (!check::finite("safety.safe_value", safe_value, why)) return false;
+  if (!(strain_min < strain_max))
+    return check::fail("safety.strain_range", "min must be < max", why);
+  if (!(stress_min < stress_max))
+    return check::fail("safety.stress_range", "min must be < max", why);
+  if (!check::non_negative("safety.watchdog_s", watchdog_s, why)) return false;
+  if (!check::require(status_period >= 1, "loop.status_period", status_period, "must be >= 1",
+                      why) ||
+      !check::require(command_capacity >= 2, "loop.command_capacity", command_capacity,
+                      "must be >= 2", why)) {
+    return false;
   }
-  if (status_period < 1) return fail("loop.status_period: must be >= 1");
-  if (command_capacity < 2) return fail("loop.command_capacity: must be >= 2");
   if (health_enabled &&
       (!health.is_valid("health.", why) || !health_bands.is_valid("health.", why))) {
     return false;

@@ -4,6 +4,8 @@
 #include <array>
 #include <limits>
 
+#include "selfsense/base/check.hpp"
+
 namespace selfsense::runtime {
 
 std::string_view to_string(Fault f) noexcept {
@@ -34,14 +36,13 @@ std::string_view cause_of(Fault f) noexcept {
 }
 
 bool OverrunPolicy::is_valid(std::string* why) const {
-  const auto fail = [why](const char* message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
-  if (consecutive < 1) return fail("safety.overrun.consecutive: must be >= 1");
-  if (within_count > 64) return fail("safety.overrun.within_count: must be in [0, 64]");
-  if (window < within_count) return fail("safety.overrun.window_cycles: must be >= within_count");
-  return true;
+  using base::check::require;
+  return require(consecutive >= 1, "safety.overrun.consecutive", consecutive, "must be >= 1",
+                 why) &&
+         require(within_count <= 64, "safety.overrun.within_count", within_count,
+                 "must be within [0, 64]", why) &&
+         require(window >= within_count, "safety.overrun.window_cycles", window,
+                 "must be >= within_count", why);
 }
 
 Supervisor::Supervisor(const OverrunPolicy& policy) noexcept : policy_(policy) {

@@ -56,8 +56,8 @@ TEST(RecorderConfig, EveryProblemNamesItsKey) {
   const std::vector<std::string> problems = validate(config);
   ASSERT_EQ(problems.size(), 4U);
   EXPECT_EQ(problems[0].rfind("recorder.prefix: ", 0), 0U);
-  EXPECT_EQ(problems[1], "recorder.rotate_bytes: must be >= 4096, got 100");
-  EXPECT_EQ(problems[2], "recorder.flush_period_ms: must be in [1, 60000], got 0");
+  EXPECT_EQ(problems[1], "recorder.rotate_bytes: 100 must be >= 4096");
+  EXPECT_EQ(problems[2], "recorder.flush_period_ms: 0 must be within [1, 60000]");
   EXPECT_EQ(problems[3].rfind("recorder.flight.post_trigger_seconds: ", 0), 0U);
   EXPECT_THROW(Recorder{config}, RecorderError);
   EXPECT_TRUE(validate(RecorderConfig{}).empty());

@@ -28,6 +28,7 @@ declare -A allowed=(
   [plant_io]="plant_io plant io base"
   [report]="report base"
   [importers]="importers io base"
+  [evaluation]="evaluation diagnosis identification adaptation models operators io report base"
   [runtime]="runtime adaptation models operators control base"
   [daemon]="daemon runtime adaptation models operators control io model_io base"
   [drivers/sim]="drivers/sim runtime models operators control plant base"

@@ -15,20 +15,19 @@
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
+#include <string>
 
-#include "selfsense/adaptation/adapted_reconstruction.hpp"
+#include "health_bench.hpp"
+#include "selfsense/adaptation/health_alarms.hpp"
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/drivers/sim/simulated_transducer.hpp"
-#include "selfsense/model_io/model_yaml.hpp"
-#include "selfsense/plant_io/plant_yaml.hpp"
 #include "selfsense/runtime/loop.hpp"
 
 namespace selfsense::runtime {
 namespace {
 
-constexpr double kTs = 1e-3;
+constexpr double kTs = test::kHealthTs;
 constexpr double kHour = 3600.0;
 constexpr double kBandPct = 3.0;
 constexpr double kStart = 120.0;  // the stack as new: the health estimate's settling and baseline
@@ -45,47 +44,25 @@ struct HourRun {
 
 HourRun run_hour(double polarisation_loss_per_h, const drivers::TemperatureRamp& temperature,
                  double seconds = kStart + kHour) {
-  const std::filesystem::path root(SELFSENSE_SOURCE_DIR);
-  plant::PlantConfig pc = plant::load_plant_file(root / "config/plant/daemon.yaml").plant;
-  pc.sample_rate_hz = 1.0 / kTs;
-  pc.mechanics.enabled = false;
-  pc.temperature.enabled = true;  // the coefficients of config/plant/temperature.yaml
-  pc.aging.enabled = polarisation_loss_per_h > 0.0;
-  pc.aging.polarisation_loss_per_h = polarisation_loss_per_h;
-  pc.aging.start_s = kStart;
-  drivers::SimulatedTransducer driver(pc, temperature);
+  drivers::SimulatedTransducer driver(test::health_plant(polarisation_loss_per_h, kStart),
+                                      temperature);
   std::string why;
   EXPECT_TRUE(driver.configure({kTs}, &why)) << why;
   EXPECT_TRUE(driver.activate(&why)) << why;
 
-  const models::TransducerModel model = models::load_model(root / "config/models/sim.yaml");
-  adaptation::DriftEstimatorConfig ec;
-  ec.load_stiffness_ratio = 0.21;  // config/sim.yaml's bench
-  LoopConfig lc;
-  lc.sample_time = kTs;
-  lc.strain_min = -1.0;
-  lc.strain_max = 1.0;
-  lc.stress_min = -1e9;
-  lc.stress_max = 1e9;
-  lc.status_period = 100;
-  lc.health_enabled = true;
+  // The coefficients were measured on this bench (DISABLED_Calibration, at constant temperatures
+  // and a faster aging, not the runs below): the reversal capacitance +0.403 %/K, the loop area
+  // -0.378 %/K, and the compensated loop's change per loss 0.76 (the load spring's share of the
+  // reversal slope).
+  LoopConfig lc = test::health_loop_config();
   lc.health_bands.max_depolarisation_pct = kBandPct;
   lc.health_bands.max_temperature_degc = 80.0;
-  // Measured on this bench (DISABLED_Calibration, at constant temperatures and a faster aging,
-  // not the runs below): the reversal capacitance +0.403 %/K, the loop area -0.378 %/K, and the
-  // compensated loop's change per loss 0.76 (the load spring's share of the reversal slope).
-  lc.health.capacitance_per_k = 4.03e-3;
-  lc.health.dissipation_per_k = -3.78e-3;
-  lc.health.depolarisation_sensitivity = 0.76;
   ControllerConfig cc;
   cc.mode = ControlMode::kOpenLoop;
-  Loop loop(lc, driver, std::make_unique<adaptation::AdaptedReconstruction>(model, ec, kTs),
-            Controller(cc, model.actuator, kTs), nullptr);
+  const std::unique_ptr<Loop> bench = test::health_loop(lc, driver, cc);
+  Loop& loop = *bench;
 
-  control::WaveGenerator::Config wc;
-  wc.amplitude = 5e-4;  // strain 1e-4 .. 1.1e-3 at 2 Hz
-  wc.offset = 6e-4;
-  wc.frequency = 2.0;
+  const control::WaveGenerator::Config wc = test::strain_sine();  // 1e-4 .. 1.1e-3 at 2 Hz
   std::uint64_t id = 0;
   const auto send = [&](LoopCommand c) {
     c.id = ++id;

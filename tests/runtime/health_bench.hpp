@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "loop_commands.hpp"
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/drivers/sim/simulated_transducer.hpp"
@@ -53,32 +54,38 @@ inline plant::PlantConfig health_plant(double polarisation_loss_per_h, double ag
   return pc;
 }
 
+// The bench's loop on `driver`: the shipped model's adapted reconstruction (the mount's ratio
+// 0.21) with the health estimate; `lc`'s sample time, ranges and health_enabled are set here.
+inline std::unique_ptr<Loop> health_loop(LoopConfig lc, drivers::SimulatedTransducer& driver,
+                                         const ControllerConfig& cc) {
+  const std::filesystem::path root(SELFSENSE_SOURCE_DIR);
+  const models::TransducerModel model = models::load_model(root / "config/models/sim.yaml");
+  adaptation::DriftEstimatorConfig ec;
+  ec.load_stiffness_ratio = 0.21;  // config/sim.yaml's bench
+  lc.sample_time = kHealthTs;
+  lc.strain_min = -1.0;
+  lc.strain_max = 1.0;
+  lc.stress_min = -1e9;
+  lc.stress_max = 1e9;
+  lc.health_enabled = true;
+  return std::make_unique<Loop>(
+      lc, driver, std::make_unique<adaptation::AdaptedReconstruction>(model, ec, kHealthTs),
+      Controller(cc, model.actuator, kHealthTs), nullptr);
+}
+
 struct HealthBench {
   explicit HealthBench(const HealthBenchOptions& o)
       : driver(health_plant(o.polarisation_loss_per_h, o.aging_start_s), o.temperature) {
-    const std::filesystem::path root(SELFSENSE_SOURCE_DIR);
     std::string why;
     EXPECT_TRUE(driver.configure({kHealthTs}, &why)) << why;
     EXPECT_TRUE(driver.activate(&why)) << why;
-    const models::TransducerModel model = models::load_model(root / "config/models/sim.yaml");
-    adaptation::DriftEstimatorConfig ec;
-    ec.load_stiffness_ratio = 0.21;  // config/sim.yaml's bench
-    LoopConfig lc = o.loop;
-    lc.sample_time = kHealthTs;
-    lc.strain_min = -1.0;
-    lc.strain_max = 1.0;
-    lc.stress_min = -1e9;
-    lc.stress_max = 1e9;
-    lc.health_enabled = true;
     ControllerConfig cc;
     cc.mode = o.mode;
     // Position on the self-sensed strain: plant gain about 6e-10 strain per V/m.
     cc.position.gains = {2e8, 2.5e11, 0.0};
     cc.position.tracking_time = 1e-2;
     cc.position_shaper.slew_rate = 0.05;
-    loop = std::make_unique<Loop>(
-        lc, driver, std::make_unique<adaptation::AdaptedReconstruction>(model, ec, kHealthTs),
-        Controller(cc, model.actuator, kHealthTs), nullptr);
+    loop = health_loop(o.loop, driver, cc);
   }
   HealthBench(const HealthBench&) = delete;
   HealthBench& operator=(const HealthBench&) = delete;
@@ -94,20 +101,7 @@ struct HealthBench {
   }
 
   // Submits and runs cycles until the loop answered.
-  CommandResult send(LoopCommand c) {
-    c.id = ++next_id;
-    EXPECT_TRUE(loop->submit(c));
-    for (int i = 0; i < 10; ++i) {
-      loop->cycle(false);
-      LoopAnswer a;
-      if (loop->take_answer(a)) {
-        EXPECT_EQ(a.id, c.id);
-        return a.result;
-      }
-    }
-    ADD_FAILURE() << "no answer";
-    return CommandResult::kInvalid;
-  }
+  CommandResult send(LoopCommand c) { return selfsense::test::send_and_cycle(*loop, next_id, c); }
   void wave(const control::WaveGenerator::Config& wc) {
     EXPECT_EQ(send({0, CommandKind::kWave, 0.0, loop->controller().mode(),
                     std::make_unique<control::WaveGenerator>(wc, kHealthTs).release()}),

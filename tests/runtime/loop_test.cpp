@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "loop_commands.hpp"
 #include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/model_io/model_yaml.hpp"
@@ -56,20 +57,7 @@ struct Bench {
         Controller(control, model.actuator, kTs), nullptr);
   }
   // Submits and runs cycles until the loop answered.
-  CommandResult send(LoopCommand c) {
-    c.id = ++next_id;
-    EXPECT_TRUE(loop->submit(c));
-    for (int i = 0; i < 10; ++i) {
-      loop->cycle(false);
-      LoopAnswer a;
-      if (loop->take_answer(a)) {
-        EXPECT_EQ(a.id, c.id);
-        return a.result;
-      }
-    }
-    ADD_FAILURE() << "no answer";
-    return CommandResult::kInvalid;
-  }
+  CommandResult send(LoopCommand c) { return test::send_and_cycle(*loop, next_id, c); }
   void run(double seconds) const {
     const auto n = static_cast<std::int64_t>(seconds * kRate);
     for (std::int64_t i = 0; i < n; ++i)
@@ -543,7 +531,7 @@ TEST(Loop, WithinCountZeroFaultsOnlyOnAStall) {
   EXPECT_EQ(b.loop->supervisor().state(), LoopState::kFaulted);
   EXPECT_NE(b.loop->supervisor().latched() & bit(Fault::kOverrun), 0U);
   EXPECT_FALSE((OverrunPolicy{2000, 65, 100}.is_valid(&why)));
-  EXPECT_EQ(why, "safety.overrun.within_count: must be in [0, 64]");
+  EXPECT_EQ(why, "safety.overrun.within_count: 65 must be within [0, 64]");
 }
 
 // A wave that ended or was stopped after playing longer than the watchdog used to fault in the

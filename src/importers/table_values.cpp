@@ -1,4 +1,4 @@
-#include "ctl_table.hpp"
+#include "selfsense/importers/table_values.hpp"
 
 #include <algorithm>
 #include <cstddef>
@@ -8,12 +8,8 @@
 
 #include "selfsense/importers/import_text.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::importers {
 
-using importers::parse_number;
-using importers::read_lines;
-using importers::split_cells;
-using importers::trim;
 namespace {
 
 bool all_numbers(const std::vector<std::string_view>& cells) {
@@ -89,4 +85,4 @@ std::vector<double> parse_number_list(std::string_view text, std::string_view wh
   return values;
 }
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::importers

@@ -1,13 +1,12 @@
-#include "field_signals.hpp"
+#include "selfsense/evaluation/field_signals.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
 
 #include "selfsense/base/format_number.hpp"
-#include "selfsense/operators/parameter_error.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::evaluation {
 namespace {
 
 // The field column if present, else the terminal column converted, else empty.
@@ -73,4 +72,4 @@ FieldSignals field_signals(const io::Recording& rec, const std::string& source,
   return out;
 }
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::evaluation

@@ -11,7 +11,7 @@
 #include "selfsense/models/geometry.hpp"
 #include "selfsense/models/transducer_model.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::evaluation {
 
 struct FieldSignals {
   std::string source{};          // file name, for messages
@@ -36,4 +36,4 @@ struct FieldSignals {
                                          const std::optional<models::Geometry>& geometry,
                                          models::Drive drive);
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::evaluation

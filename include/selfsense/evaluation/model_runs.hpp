@@ -8,12 +8,13 @@
 #include <string>
 #include <vector>
 
-#include "field_signals.hpp"
+#include "selfsense/adaptation/drift_estimator.hpp"
+#include "selfsense/evaluation/field_signals.hpp"
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/models/runtime_model.hpp"
 #include "selfsense/models/transducer_model.hpp"
 
-namespace selfsense::cli {
+namespace selfsense::evaluation {
 
 struct ModelRuns {
   std::vector<double> sensed{};  // D_model (field drive) or E_model (charge drive)
@@ -50,6 +51,27 @@ struct ChannelFigures {
                                                   const ModelRuns& runs, std::size_t from,
                                                   std::size_t to);
 
+// The figures of forward and reconstruction over the whole recording.
+[[nodiscard]] std::vector<ChannelFigures> figures(const models::TransducerModel& model,
+                                                  const FieldSignals& signals);
+
 [[nodiscard]] nlohmann::json to_json(const std::vector<ChannelFigures>& figures);
 
-}  // namespace selfsense::cli
+// `reconstruct --adapt` (docs/adaptation.md): the adapted reconstruction over the recording, with
+// the equivalent temperature and the permittivity drift per sample. With a temperature [degC] per
+// sample the drift estimate is frozen and follows that temperature instead.
+struct AdaptedRuns {
+  std::vector<double> stress_hat{};
+  std::vector<double> strain_hat{};  // empty without a strain estimate
+  std::vector<double> estimate_status{};
+  std::vector<double> temp_equivalent{};     // [degC]
+  std::vector<double> permittivity_drift{};  // [1]
+  models::StatusCounts counts{};
+  std::size_t updates{0};  // of the drift estimate
+  adaptation::Drift last{};
+};
+[[nodiscard]] AdaptedRuns run_adapted(const models::TransducerModel& model,
+                                      const FieldSignals& signals,
+                                      const std::vector<double>& temperature);
+
+}  // namespace selfsense::evaluation

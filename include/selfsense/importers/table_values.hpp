@@ -7,11 +7,11 @@
 #include <string_view>
 #include <vector>
 
-namespace selfsense::cli {
+namespace selfsense::importers {
 
 [[nodiscard]] std::vector<double> read_table_values(const std::filesystem::path& path);
 
 // "0,1e-4,-2e-4" as numbers; throws std::runtime_error naming `what` and the bad cell.
 [[nodiscard]] std::vector<double> parse_number_list(std::string_view text, std::string_view what);
 
-}  // namespace selfsense::cli
+}  // namespace selfsense::importers

@@ -1,9 +1,10 @@
-#include "model_runs.hpp"
+#include "selfsense/evaluation/model_runs.hpp"
 
-#include <cstdio>
 #include <span>
 
-namespace selfsense::cli {
+#include "selfsense/adaptation/adapted_reconstruction.hpp"
+
+namespace selfsense::evaluation {
 
 ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& signals, bool forward,
                     bool reconstruct) {
@@ -95,6 +96,11 @@ std::vector<ChannelFigures> figures(const models::TransducerModel& model,
   return out;
 }
 
+std::vector<ChannelFigures> figures(const models::TransducerModel& model,
+                                    const FieldSignals& signals) {
+  return figures(model, signals, run_model(model, signals, true, true), 0, signals.size());
+}
+
 nlohmann::json to_json(const std::vector<ChannelFigures>& figures) {
   nlohmann::json out = nlohmann::json::object();
   for (const ChannelFigures& f : figures) {
@@ -103,4 +109,33 @@ nlohmann::json to_json(const std::vector<ChannelFigures>& figures) {
   return out;
 }
 
-}  // namespace selfsense::cli
+AdaptedRuns run_adapted(const models::TransducerModel& model, const FieldSignals& signals,
+                        const std::vector<double>& temperature) {
+  adaptation::DriftEstimatorConfig config{};
+  config.frozen = !temperature.empty();
+  adaptation::AdaptedReconstruction adapted(model, config, signals.sample_time);
+  const std::span<const double> x = signals.drive(model.drive());
+  const std::span<const double> y = signals.sensed(model.drive());
+  const std::size_t n = signals.size();
+  AdaptedRuns runs;
+  runs.stress_hat.resize(n);
+  runs.strain_hat.resize(adapted.has_strain() ? n : 0);
+  runs.estimate_status.resize(n);
+  runs.temp_equivalent.resize(n);
+  runs.permittivity_drift.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!temperature.empty()) adapted.set_temperature(temperature[k]);
+    const adaptation::AdaptedReconstruction::Estimate est = adapted.step(x[k], y[k]);
+    runs.stress_hat[k] = est.stress;
+    if (!runs.strain_hat.empty()) runs.strain_hat[k] = est.strain;
+    runs.estimate_status[k] = static_cast<double>(est.status);
+    runs.temp_equivalent[k] = adapted.drift().temperature_degc;
+    runs.permittivity_drift[k] = adapted.drift().permittivity;
+  }
+  runs.counts = adapted.counts();
+  runs.updates = adapted.estimator().updates();
+  runs.last = adapted.drift();
+  return runs;
+}
+
+}  // namespace selfsense::evaluation
