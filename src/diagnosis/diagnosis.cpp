@@ -164,7 +164,8 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
     };
     // A loop identified on a creeping stack bends to the creep, and one identified with a leak
     // bends its operators to the leak: on a model without creep operators, where the rounds name
-    // creep or nothing on the channel, the structure with them is judged by re-identification,
+    // nothing on the channel but creep and the loop's shape (a loop bent to the creep shows as
+    // a change of its shape too), the structure with them is judged by re-identification,
     // and on the sensed channel the leak too (also where nothing is named on a re-identified
     // side). Over one record a slow lag integrates like a leak, so each imitates the other. The
     // leak goes first where the creep does not hold or the leak does better on both halves (the
@@ -172,8 +173,11 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
     // (the disc's holds: the creep fits its half 99.8 % better and forecasts 66 %, the leak 33 %
     // and 79 %; on its validation block the creep structure is 6 %, the leak 14 %). The other is
     // then judged beside the first.
+    const bool creep_or_loop_shape = std::all_of(found.begin(), found.end(), [](const Finding& f) {
+      return f.effect == "creep" || f.effect == "hysteresis" || f.effect == "asymmetric_hysteresis";
+    });
     const bool creep_candidate =
-        !reidentified && model.structure == models::Structure::kHysteresis && named_only("creep");
+        !reidentified && model.structure == models::Structure::kHysteresis && creep_or_loop_shape;
     const bool leak_candidate = ch.sensed && !stressed && (found.empty() || creep_candidate);
     std::optional<Reidentified> creep =
         creep_candidate ? reidentified_creep(model, s, ch, model_output, options) : std::nullopt;
