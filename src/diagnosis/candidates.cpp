@@ -209,9 +209,14 @@ void describe_stress(Finding& f, const Evidence& e) {
                      std::abs(c.stress_quadratic_per_pa2) * t * t * pct, t * 1e-6) +
                  tail;
   } else {
+    double mean = 0.0;
+    for (const double t : s.stress)
+      mean += t / static_cast<double>(s.stress.size());
     f.evidence = "the coupling of " + n +
-                 format(" changes with stress by %.3g %% per MPa over %.3g MPa",
-                        100.0 * c.stress_gain_per_pa * 1e6, range_of(s.stress) * 1e-6) +
+                 format(
+                     " changes with stress by %.3g %% per MPa over %.3g MPa, about the "
+                     "recording's mean of %.3g MPa where the model's coupling was fitted",
+                     100.0 * c.stress_gain_per_pa * 1e6, range_of(s.stress) * 1e-6, mean * 1e-6) +
                  tail;
   }
   f.feature_name = "stress T [Pa]";
@@ -475,6 +480,9 @@ bool searches_filter(const Candidate& c, const ChannelCorrection& accepted) {
 }
 
 std::size_t complexity(const std::vector<CorrectionTerm>& terms) {
+  const auto uses = [&](CorrectionTerm t) {
+    return std::find(terms.begin(), terms.end(), t) != terms.end();
+  };
   std::size_t n = 0;
   for (const CorrectionTerm t : terms) {
     switch (t) {
@@ -491,6 +499,9 @@ std::size_t complexity(const std::vector<CorrectionTerm>& terms) {
       case CorrectionTerm::kCreep:
       case CorrectionTerm::kDriveCreep:
         n += 5;
+        break;
+      case CorrectionTerm::kStress:  // T r, and T unless kStressDrive brings it
+        n += uses(CorrectionTerm::kStressDrive) ? 1U : 2U;
         break;
       case CorrectionTerm::kHysteresis:
         n += 9;  // the linear play and 8 plays (correction_fit.cpp)

@@ -346,18 +346,23 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
   if (!std::all_of(first.findings.begin(), first.findings.end(), is_stress)) return first;
   // A loop and coupling that move with the stress bend an affine base: where nothing but the
   // stress is named, judged for the whole model (it replaces both sides) by re-identification
-  // with the stress-hysteresis structure. It is taken where it names the stress on a channel
-  // the corrections did not (they carry the coupling's change on S, not the permittivity's and
-  // the loop's on D); then each channel's rounds run on it and no side is re-identified again.
+  // with the stress-hysteresis structure (the corrections carry a coupling's change, not a loop
+  // that moves with T); then each channel's rounds run on it and no side is re-identified again.
   const std::optional<StressReidentified> stressed =
       reidentified_stress(model, s, channels, options);
   if (!stressed) return first;
-  const bool adds_a_channel =
+  // Taken where it names a channel the corrections did not, or explains more of a channel they
+  // named: its share is of forecasts a half ahead, theirs of interleaved held-out blocks, so a
+  // larger share of the harsher test is the better model of that channel.
+  const bool better =
       std::any_of(stressed->named.begin(), stressed->named.end(), [&](const Finding& f) {
-        return std::none_of(first.findings.begin(), first.findings.end(),
-                            [&](const Finding& g) { return g.channel == f.channel; });
+        double corrected = 0.0;  // the findings' shares of one channel add up
+        for (const Finding& g : first.findings) {
+          if (g.channel == f.channel) corrected += g.explains;
+        }
+        return f.explains > corrected;
       });
-  return adds_a_channel ? diagnose_channels(context, channels, outputs, stressed) : first;
+  return better ? diagnose_channels(context, channels, outputs, stressed) : first;
 }
 
 }  // namespace selfsense::diagnosis

@@ -138,6 +138,12 @@ Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm>
         break;
       case CorrectionTerm::kStress:
         add([&](std::size_t k) { return at(s.stress, k, 0.0) * at(s.response, k, s.y[k]); });
+        // The model's coupling was identified at the recording's mean stress T0: a coupling
+        // d (1 + k T) leaves k (T - T0) r, which T r alone can only reach with the gain on y = r +
+        // coupling T and the stress's own column beside it (with kStressDrive, that adds it).
+        if (!has_term(terms, CorrectionTerm::kStressDrive)) {
+          add([&](std::size_t k) { return at(s.stress, k, 0.0); });
+        }
         break;
       case CorrectionTerm::kDriveCreep:
         c.drive_creep_eigenvalues = lag_eigenvalues(n, s.sample_time);
@@ -242,6 +248,7 @@ void apply_coefficients(std::span<const CorrectionTerm> terms, const Columns& co
         break;
       case CorrectionTerm::kStress:
         out.stress_gain_per_pa = c[i++];
+        if (!has_term(terms, CorrectionTerm::kStressDrive)) out.stress_linear_per_pa = c[i++];
         break;
       case CorrectionTerm::kDriveCreep:
         out.drive_creep_eigenvalues = columns.drive_creep_eigenvalues;

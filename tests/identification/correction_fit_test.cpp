@@ -55,6 +55,39 @@ TEST(CorrectionFit, FindsAPlantedGainAndOffset) {
   EXPECT_LT(fit.fit_sse, 1e-20);
 }
 
+// A coupling d (1 + k T) under a preload T0: a model identified there has the coupling
+// d (1 + k T0) in its response r and leaves k (T - T0) r, whatever T0 is. The stress term reaches
+// it with the gain (on y = r + s T) and the stress's own column: found exactly.
+TEST(CorrectionFit, StressGainIsFoundAboutTheRecordingsPreload) {
+  Bench b = bench();
+  constexpr double kCompliance = 2e-8;  // s [channel unit / Pa]
+  constexpr double kPerPa = 3e-8;       // k
+  constexpr double kPreload = -3e6;     // T0 [Pa]
+  std::vector<double> stress;
+  std::vector<double> response;
+  for (std::size_t k = 0; k < b.x.size(); ++k) {
+    const double t = static_cast<double>(k) * kTs;
+    const double r = b.y[k];
+    stress.push_back(kPreload + 1e6 * std::sin(1.3 * t) + 2e5 * std::sin(37.0 * t));
+    response.push_back(r);
+    b.y[k] = r + kCompliance * stress[k];
+    b.recorded[k] = r * (1.0 + kPerPa * (stress[k] - kPreload)) + kCompliance * stress[k];
+  }
+  CorrectionSignals s = b.signals();
+  s.stress = stress;
+  s.response = response;
+  const std::vector<CorrectionTerm> terms{CorrectionTerm::kStress, CorrectionTerm::kOffset};
+  const CorrectionFit fit = fit_correction(s, terms, {}, std::vector<bool>(b.x.size(), true));
+  EXPECT_NEAR(fit.correction.stress_gain_per_pa, kPerPa, 1e-6 * kPerPa);
+  EXPECT_NEAR(fit.correction.gain, -kPerPa * kPreload, 1e-6);
+  EXPECT_NEAR(fit.correction.stress_linear_per_pa, kPerPa * kPreload * kCompliance,
+              1e-6 * kPerPa * 3e6 * kCompliance);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < b.x.size(); ++k)
+    worst = std::max(worst, std::abs(fit.output[k] - b.recorded[k]));
+  EXPECT_LT(worst, 1e-9);  // of a response up to 2.4
+}
+
 TEST(CorrectionFit, HeldOutOutputsEqualFitsWithoutEachFold) {
   const Bench b = bench();
   const std::size_t n = b.x.size();
