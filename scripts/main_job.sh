@@ -5,7 +5,11 @@
 # force impulse from the bench (`ctl impulse`) in open loop and again with positive position
 # feedback on S_hat. For each, from the daemon's own recording, the tracking error of S_hat (or
 # T_hat) and of the plant's true S (or T) against the setpoint, or the ring-down times; an HTML
-# page with the plots; a clean stop of each daemon.
+# page with the plots; a clean stop of each daemon. Then the self-heating run on
+# config/heating-sim.yaml (the stack warms with the power it takes): a 200 Hz sine in open loop
+# warms it by more than 15 K, then position steps, once with the online adaptation and once on a
+# fresh daemon without it; the figures of both beside each other and the plant's temperature
+# against the adaptation's equivalent temperature on the page.
 # Each run watches the daemon's state (scripts/daemon_runs.sh): a run in which the loop faults
 # is reported (fault, cycle, time, cause; OUT_DIR/faults.txt) and done again once; a second
 # fault ends the job with exit 1 and no figures. The figures count armed samples only
@@ -27,8 +31,8 @@ rm -f "$out/faults.txt"
 # shellcheck source=scripts/daemon_runs.sh
 source "$root/scripts/daemon_runs.sh"
 
-# start_daemon SHIPPED_CONFIG: the configuration with this run's paths, checked, and selfsensed
-# started on it; waits for its socket. The copy is written into OUT_DIR/config, never into the
+# start_daemon SHIPPED_CONFIG [SED_SCRIPT]: the configuration with this run's paths (and the
+# further edit SED_SCRIPT), checked, and selfsensed started on it; waits for its socket. The copy is written into OUT_DIR/config, never into the
 # source tree: models/ and plant/ there are links to the shipped ones, so its relative paths
 # (model: models/sim.yaml, plant: plant/daemon.yaml) resolve as the shipped file's do.
 mkdir -p "$out/config"
@@ -40,7 +44,7 @@ start_daemon() {
   sed -e "s|directory: ../build/[a-z-]*/recordings|directory: $out/recordings|" \
     -e "s|path: ../build/[a-z-]*/control.sock|path: $out/control.sock|" \
     -e "s|prometheus_file: ../build/[a-z-]*/selfsensed.prom|prometheus_file: $out/selfsensed.prom|" \
-    "$1" >"$config"
+    -e "${2:-}" "$1" >"$config"
   "$cli" check-config "$config"
   rm -f "$out/control.sock"  # the previous daemon's
   "$daemon" --config "$config" >>"$out/daemon.log" 2>&1 &
@@ -118,6 +122,38 @@ if [ -z "${SELFSENSE_MAIN_JOB_CONFIG:-}" ]; then
   watched_run damped damping damping_run
   stop_daemon
   segments+=(undamped damped)
+
+  echo "== self-heating: a 200 Hz sine in open loop warms the stack, then position steps; with adaptation, then without"
+  # Each on a fresh daemon: its plant starts at 25 degC. The sine (3000 periods, 15 s of the
+  # loop's clock, which a late cycle stretches) starts and ends at its offset; once it has
+  # ended, the position mode holds there and a table plays the position run's staircase with
+  # edges of 3 ms. (The heating configuration's shaper lets the setpoint
+  # move 1.0 per s, which the sine needs; a setpoint step at that slew takes 0.5 ms, one period
+  # of the mount's 2 kHz resonance, which rings it. The edges of 3 ms come near the position
+  # run's, 9 ms at 0.05 per s; each still moves the setpoint by more than 1 % of its range per
+  # sample, so the figures take it for a step.)
+  awk 'BEGIN {
+    n = split("6.0e-4 1.5e-4 6.0e-4 1.05e-3 3.5e-4 8.0e-4", level, " ")
+    for (i = 1; i <= n; i++) for (k = 0; k < (i == 1 ? 67 : 267); k++) print level[i]
+  }' >"$out/heating-steps.txt"
+  heating_run() {
+    record_start "$1"
+    ctl wave sine --amplitude 4.5e-4 --offset 6.0e-4 --frequency 200 --repeat 3000 >/dev/null
+    hold 15
+    while [[ $(daemon_status) =~ \"wave_running\":true ]]; do hold 0.05; done
+    ctl mode position >/dev/null
+    ctl wave table --table "$out/heating-steps.txt" --dt 0.003 --repeat 1 >/dev/null
+    hold 4.3
+  }
+  start_daemon "$root/config/heating-sim.yaml"
+  watched_run heating-adapted open-loop heating_run
+  ctl status --pretty >"$out/status-heating.json"
+  stop_daemon
+  start_daemon "$root/config/heating-sim.yaml" \
+    's|^  enabled: true \( *# true: the loop runs the adapted\)|  enabled: false\1|'
+  watched_run heating-plain open-loop heating_run
+  stop_daemon
+  segments+=(heating-adapted heating-plain)
 fi
 trap - EXIT
 SELFSENSE_CLI=$cli "$root/scripts/main_job_report.sh" "$out" "${segments[@]}"

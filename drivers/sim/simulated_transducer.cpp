@@ -75,6 +75,7 @@ runtime::DriverStatus SimulatedTransducer::read(runtime::InputSample& out) noexc
   out.d = o.d_meas_c_per_m2;
   out.s_ref = o.s;
   out.t_ref = o.t_pa;
+  if (has_temperature()) out.temp_ref = o.temp_degc;
   out.timestamp_ns = static_cast<std::int64_t>(std::llround(o.t_s * 1e9));
   out.device_status = static_cast<std::uint16_t>(status & 0xffffU);
   // Each fault flag of the cycle counts under its own name (the status below takes the first).

@@ -92,6 +92,8 @@ AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& mode
     }
     const double r = config.load_stiffness_ratio;
     mount_gain_ = -(r / kernel_.actuator()->coupling()) / (1.0 + r);
+    mount_ratio_ = r;
+    mount_kappa_ = r / kernel_.actuator()->coupling();
   }
 }
 
@@ -129,8 +131,14 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field,
     pa = actuator_split_->split(a, field, a.step_unloaded(field) - fixed_a);
   }
   const double mount_stress = mount_gain_ * (fixed_a + pa.linear + pa.loop);  // header comment
-  estimator_.step(field, sensed - fixed_s - s.coupling() * mount_stress, ps.linear, ps.loop,
-                  accepted);
+  // The mount's share of D as the stack is now: the free strain, the stiffness ratio and the
+  // sensor's coupling with the drift learned so far.
+  const Drift now = estimator_.drift();
+  const double mount_now =
+      -mount_kappa_ / (1.0 + mount_ratio_ * (1.0 + now.compliance)) *
+      (fixed_a + (1.0 + now.coupling) * pa.linear + (1.0 + now.loop) * pa.loop);
+  estimator_.step(field, sensed - fixed_s - (1.0 + now.coupling) * s.coupling() * mount_now,
+                  ps.linear, ps.loop, accepted);
   const Drift dr = estimator_.drift();
   const double unloaded = fixed_s + (1.0 + dr.permittivity) * ps.linear + (1.0 + dr.loop) * ps.loop;
   Estimate out{(sensed - unloaded) / ((1.0 + dr.coupling) * s.coupling()), kNaN,

@@ -87,6 +87,9 @@ void read_run(MainJobRun& run, const fs::path& path, bool& failed) {
     run.estimate = column_or_empty(r, force ? "T_hat" : "S_hat");
     run.reference = column_or_empty(r, force ? "T" : "S");
     run.field = column_or_empty(r, "E");
+    run.mode = column_or_empty(r, "mode");
+    run.temperature = column_or_empty(r, "temp");
+    run.temperature_estimate = column_or_empty(r, "temp_equivalent");
     const std::vector<double> cycle = column_or_empty(r, "cycle");
     const std::vector<double> faults = column_or_empty(r, "faults");
     for (std::size_t i = 0; i < run.state.size(); ++i) {
@@ -136,7 +139,9 @@ int run_command(const Options& o) {
     page.runs.push_back(std::move(run));
   }
   for (const std::string& line : figures) {
-    if (starts_with(line, "damping: ")) page.summary.push_back(line);
+    if (starts_with(line, "damping: ") || starts_with(line, "self-heating: ")) {
+      page.summary.push_back(line);
+    }
   }
   // "FAULT: position: run 1 of 2: ...; recording: PATH" (scripts/daemon_runs.sh).
   const std::regex fault_line(

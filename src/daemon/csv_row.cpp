@@ -35,6 +35,8 @@ std::vector<std::string> RowFormat::column_names() const {
     names.emplace_back("S");
     names.emplace_back("T");
   }
+  if (temperature_) names.emplace_back("temp");
+  if (temperature_equivalent_) names.emplace_back("temp_equivalent");
   for (const char* name :
        {"mode", "faults", "estimate_status", "driver_status", "nonfinite", "cycle"}) {
     names.emplace_back(name);
@@ -72,6 +74,10 @@ std::size_t RowFormat::format(const runtime::LoopSample& s, char* out) const noe
   if (references_) {
     p = put_double(p, s.s_ref, nonfinite::kS, mask);
     p = put_double(p, s.t_ref, nonfinite::kT, mask);
+  }
+  if (temperature_) p = put_double(p, s.temp_ref, nonfinite::kTemp, mask);
+  if (temperature_equivalent_) {
+    p = put_double(p, s.temp_equivalent, nonfinite::kTempEquivalent, mask);
   }
   p = put_int(p, static_cast<unsigned>(s.mode), ',');
   p = put_int(p, s.faults, ',');

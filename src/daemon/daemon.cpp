@@ -41,14 +41,16 @@ class Daemon::Sink final : public runtime::SampleSink {
 
 namespace {
 
-RecorderConfig recorder_config(const DaemonConfig& c, bool references) {
+RecorderConfig recorder_config(const DaemonConfig& c, const runtime::Driver& driver) {
   RecorderConfig r;
   r.directory = c.recorder.directory;
   r.prefix = "selfsensed";
   r.rotate_bytes = static_cast<std::size_t>(c.recorder.rotate_bytes);
   r.flush_period_ms = c.recorder.flush_ms;
   r.ring_capacity = c.recorder.ring_capacity;
-  r.references = references;
+  r.references = driver.has_references();
+  r.temperature = driver.has_temperature();
+  r.temperature_equivalent = c.adaptation.enabled;
   r.sample_time_s = c.sample_time();
   r.comments = {"config " + c.source.string(), "model " + c.model.string()};
   r.flight.seconds = c.recorder.flight_recorder_s;
@@ -101,8 +103,7 @@ Daemon::Daemon(DaemonConfig config, std::unique_ptr<runtime::Driver> driver,
     throw std::runtime_error("driver: " + why);
   }
   std::filesystem::create_directories(config_.recorder.directory);
-  recorder_ =
-      std::make_unique<Recorder>(recorder_config(config_, driver_->has_references()), fault_name);
+  recorder_ = std::make_unique<Recorder>(recorder_config(config_, *driver_), fault_name);
   sink_ = std::make_unique<Sink>(*recorder_);
   loop_ = adapted
               ? std::make_unique<runtime::Loop>(config_.loop_config(), *driver_, std::move(adapted),

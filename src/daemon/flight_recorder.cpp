@@ -39,10 +39,16 @@ std::string file_safe(const std::string& text) {
 FlightRecorder::FlightRecorder(const FlightRecorderConfig& config,
                                const std::filesystem::path& default_directory, double sample_time_s,
                                bool references, FaultNamer fault_namer)
+    : FlightRecorder(config, default_directory, sample_time_s, RowFormat(references),
+                     std::move(fault_namer)) {}
+
+FlightRecorder::FlightRecorder(const FlightRecorderConfig& config,
+                               const std::filesystem::path& default_directory, double sample_time_s,
+                               RowFormat format, FaultNamer fault_namer)
     : config_(config),
       directory_(config.directory.empty() ? default_directory : config.directory),
       sample_time_s_(sample_time_s),
-      references_(references),
+      format_(format),
       fault_namer_(std::move(fault_namer)),
       history_(static_cast<std::size_t>(std::ceil(config.seconds / sample_time_s))),
       post_trigger_samples_(
@@ -139,7 +145,7 @@ FlightRecorder::Dump FlightRecorder::write(const std::filesystem::path& path,
                      std::to_string(history_.size()) +
                      "); left out for a bad or repeated t: " + std::to_string(count_ - kept));
 
-  RecordingFile file(RowFormat(references_), kDumpChunkBytes);
+  RecordingFile file(format_, kDumpChunkBytes);
   file.open(path, comments);
   RecordingFile::Result outcome;
   for (std::size_t i = 0; i < count_ && outcome.error == 0; ++i) {

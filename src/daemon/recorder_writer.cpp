@@ -28,10 +28,15 @@ constexpr auto kIdleWait = std::chrono::milliseconds(1);
 
 constexpr const char* kUnitsComment =
     "units: t s, E V/m, D C/m^2, T_hat Pa, S_hat -, setpoint S - (position) or T Pa (force), "
-    "command V/m, S -, T Pa";
+    "command V/m, S -, T Pa, temp degC, temp_equivalent degC";
 constexpr const char* kCodesComment =
     "codes: state 0 faulted 1 ready 2 armed; mode 0 position 1 force 2 open-loop 3 damping; "
-    "nonfinite (value written as 0) E 1 D 2 T_hat 4 S_hat 8 setpoint 16 command 32 S 64 T 128";
+    "nonfinite (value written as 0) E 1 D 2 T_hat 4 S_hat 8 setpoint 16 command 32 S 64 T 128 "
+    "temp 256 temp_equivalent 512";
+
+RowFormat row_format(const RecorderConfig& c) noexcept {
+  return {c.references, c.temperature, c.temperature_equivalent};
+}
 
 template <typename Counter>
 void add_to(Counter& counter, std::uint64_t n) noexcept {
@@ -46,8 +51,8 @@ Recorder::Writer::Writer(Recorder& owner, FaultNamer fault_namer)
       config_(owner.config_),
       flush_period_(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
           std::chrono::duration<double, std::milli>(config_.flush_period_ms))),
-      file_(RowFormat(config_.references), kChunkBytes),
-      flight_(config_.flight, config_.directory, config_.sample_time_s, config_.references,
+      file_(row_format(config_), kChunkBytes),
+      flight_(config_.flight, config_.directory, config_.sample_time_s, row_format(config_),
               std::move(fault_namer)),
       batch_(kBatch) {}
 

@@ -18,16 +18,20 @@ constexpr int kLegendColumn = 230;
 constexpr int kMainHeight = 300;
 constexpr int kErrorHeight = 220;
 constexpr int kFieldHeight = 180;
+constexpr int kTemperatureHeight = 220;
 constexpr double kPerMicro = 1e6;        // strain [-] -> [1e-6]
 constexpr double kMegaPerUnit = 1e-6;    // Pa -> MPa, V/m -> kV/mm (1 kV/mm = 1e6 V/m)
 constexpr double kRestFraction = 0.6;    // the rest: the mean from 60 % of the samples on
 constexpr double kBeforePeak = 0.05;     // [s] of the ring-down window before the peak
 constexpr double kRingDownWindow = 0.4;  // [s]
+constexpr double kModePosition = 0.0;    // the recording's `mode` code
 constexpr std::string_view kTimeLabel = "time t [s]";
 constexpr std::string_view kSetpointColour = "#111111";
 constexpr std::string_view kEstimateColour = "#1f77b4";
 constexpr std::string_view kReferenceColour = "#d62728";
 constexpr std::string_view kFieldColour = "#2ca02c";
+constexpr std::string_view kTemperatureColour = "#d62728";
+constexpr std::string_view kEquivalentColour = "#1f77b4";
 constexpr std::string_view kFaultedColour = "#d62728";
 constexpr std::string_view kReadyColour = "#999999";
 constexpr std::string_view kMarkerColour = "#8b0000";
@@ -103,6 +107,52 @@ std::string fault_caption(const MainJobRun& run) {
          escape_html(run.fault_text) + "); shaded red: samples in the faulted state.";
 }
 
+// The self-heating run: the self-sensing error over the whole run, and the plant's temperature
+// against the adaptation's equivalent temperature. Nothing without a recorded temperature.
+std::string temperature_plots(const MainJobRun& run, std::span<const double> t) {
+  const std::size_t n = t.size();
+  const bool has_temperature = run.temperature.size() >= n;
+  const bool has_equivalent = run.temperature_estimate.size() >= n;
+  if (n == 0 || (!has_temperature && !has_equivalent)) return "";
+  const Quantity q = quantity_of(run.kind);
+  std::string out;
+  if (run.reference.size() >= n && run.estimate.size() >= n) {
+    std::vector<double> error(n);
+    for (std::size_t i = 0; i < n; ++i)
+      error[i] = q.scale * (run.estimate[i] - run.reference[i]);
+    SvgPlot err(run.heading + ": self-sensing error", std::string(kTimeLabel),
+                q.symbol + "_hat - " + q.symbol + " " + q.error_axis.substr(6), kWidth,
+                kErrorHeight);
+    err.set_legend_column(kLegendColumn);
+    mark_states(err, run);
+    err.add_reference("", 0.0, std::string(kZeroColour));
+    err.add_line(q.symbol + "_hat - " + q.symbol, t, error, std::string(kEstimateColour));
+    out += figure(err,
+                  "The estimate against the plant's truth over every sample, the fast sine "
+                  "that warms the stack included.");
+  }
+  SvgPlot temp(run.heading + ": the stack's temperature", std::string(kTimeLabel),
+               "temperature [degC]", kWidth, kTemperatureHeight);
+  temp.set_legend_column(kLegendColumn);
+  mark_states(temp, run);
+  if (has_temperature) {
+    temp.add_line("plant (true)", t, std::span<const double>(run.temperature).first(n),
+                  std::string(kTemperatureColour));
+  }
+  if (has_equivalent) {
+    temp.add_line("equivalent (adaptation)", t,
+                  std::span<const double>(run.temperature_estimate).first(n),
+                  std::string(kEquivalentColour));
+  }
+  out +=
+      figure(temp, std::string("Red: the simulated stack's temperature (the plant's self-heating, "
+                               "never seen by the loop)") +
+                       (has_equivalent ? "; blue: the equivalent temperature the adaptation "
+                                         "learns from E and D alone."
+                                       : "; this run does not adapt."));
+  return out;
+}
+
 std::string tracking_plots(const MainJobRun& run) {
   const Quantity q = quantity_of(run.kind);
   const std::size_t n = std::min({run.t.size(), run.setpoint.size(), run.estimate.size()});
@@ -128,7 +178,11 @@ std::string tracking_plots(const MainJobRun& run) {
                 ", the loop's self-sensed estimate from E and D only; red: " + q.symbol +
                 ", the simulated plant's truth, never seen by the loop." + fault_caption(run));
 
-  const std::vector<bool> settled = settled_samples(t, setpoint, run.state);
+  std::vector<bool> settled = settled_samples(t, setpoint, run.state);
+  if (run.kind == MainJobRun::Kind::kPosition && run.mode.size() >= n) {
+    for (std::size_t i = 0; i < n; ++i)
+      settled[i] = settled[i] && run.mode[i] == kModePosition;
+  }
   std::vector<double> error_hat(n, kNaN);
   std::vector<double> error_true(n, kNaN);
   for (std::size_t i = 0; i < n; ++i) {
@@ -149,11 +203,12 @@ std::string tracking_plots(const MainJobRun& run) {
   if (has_reference) {
     error.add_line(q.symbol + " - setpoint", t, error_true, std::string(kReferenceColour));
   }
-  out +=
-      figure(error, "The error the figures measure: over the armed samples from " +
-                        format_number(kSettleTime) +
-                        " s after each setpoint step on (the gaps are the samples not counted).");
+  out += figure(error, "The error the figures measure: over the armed samples from " +
+                           format_number(kSettleTime) + " s after each setpoint step on" +
+                           (run.kind == MainJobRun::Kind::kPosition ? ", in position mode" : "") +
+                           " (the gaps are the samples not counted).");
 
+  out += temperature_plots(run, t);
   if (run.field.size() >= n) {
     SvgPlot field(run.heading + ": the field the loop drives", std::string(kTimeLabel),
                   "field E [kV/mm]", kWidth, kFieldHeight);

@@ -326,6 +326,7 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
   sample.d = in.d;
   sample.s_ref = in.s_ref;
   sample.t_ref = in.t_ref;
+  sample.temp_ref = in.temp_ref;
   sample.driver_status = in.device_status;
   if (read == DriverStatus::kOk) {
     const models::Reconstruction::Estimate est = estimate(in.e, in.d);
@@ -381,6 +382,7 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
   sample.state = supervisor_.state();
   sample.mode = controller_.mode();
   sample.faults = supervisor_.latched();
+  if (adapted_) sample.temp_equivalent = adapted_->drift().temperature_degc;
   if (sink_ != nullptr && !sink_->push(sample)) ++status_.samples_dropped;
 
   status_.cycle = cycle_;

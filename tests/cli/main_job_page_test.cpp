@@ -159,5 +159,39 @@ TEST(MainJobPage, RingDownRunsAndUnreadableRecordings) {
   EXPECT_THROW(write_main_job_page(page, "/nonexistent-dir/page.html"), std::runtime_error);
 }
 
+// The self-heating run (scripts/main_job.sh): open loop first, then position; with the plant's
+// temperature and the adaptation's equivalent temperature recorded.
+TEST(MainJobPage, TheSelfHeatingRunPlotsTheTemperaturesAndTheSelfSensingError) {
+  MainJobRun adapted = position_run(0.0);
+  adapted.heading = "heating-adapted";
+  for (std::size_t i = 0; i < adapted.t.size(); ++i) {
+    adapted.mode.push_back(adapted.t[i] < 11.0 ? 2.0 : 0.0);  // open-loop, then position
+    adapted.temperature.push_back(25.0 + static_cast<double>(i) * 1e-2);
+    adapted.temperature_estimate.push_back(25.0 + static_cast<double>(i) * 0.9e-2);
+  }
+  MainJobRun plain = adapted;
+  plain.heading = "heating-plain";
+  plain.temperature_estimate.clear();
+  MainJobPage page;
+  page.runs = {adapted, plain};
+  const std::string html = main_job_page_html(page);
+  // Each run: setpoint/estimate/truth, tracking error, S_hat - S, temperature, field.
+  EXPECT_EQ(count(html, "<svg"), 10U);
+  EXPECT_EQ(count(html, ">temperature [degC]</text>"), 2U);
+  EXPECT_EQ(count(html, ">S_hat - S [1e-6]</text>"), 2U);
+  EXPECT_EQ(count(html, ">plant (true)</text>"), 2U);
+  EXPECT_EQ(count(html, ">equivalent (adaptation)</text>"), 1U);
+  EXPECT_EQ(count(html, "this run does not adapt"), 1U);
+  EXPECT_NE(html.find(">heating-adapted: the stack&#39;s temperature</text>"), std::string::npos)
+      << html.substr(0, 2000);
+  EXPECT_EQ(count(html, "in position mode (the gaps"), 2U);
+  // A run without temperatures has no such plots.
+  MainJobPage position_only;
+  position_only.runs = {position_run(0.0)};
+  const std::string other = main_job_page_html(position_only);
+  EXPECT_EQ(count(other, "<svg"), 3U);
+  EXPECT_EQ(count(other, "temperature"), 0U);
+}
+
 }  // namespace
 }  // namespace selfsense::report

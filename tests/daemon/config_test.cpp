@@ -29,7 +29,7 @@ bool has(const ConfigResult& r, const std::string& text) {
 }
 
 TEST(DaemonConfig, ShippedConfigurationsLoad) {
-  for (const char* name : {"sim.yaml", "selfsensed.yaml"}) {
+  for (const char* name : {"sim.yaml", "selfsensed.yaml", "heating-sim.yaml"}) {
     drivers::Registry registry;
     const ConfigResult r = load_config(kConfigDir / name, &registry);
     EXPECT_TRUE(r.ok()) << name << ": " << (r.problems.empty() ? "" : r.problems.front());

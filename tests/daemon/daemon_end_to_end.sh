@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # selfsensed end to end on the simulated transducer, paced in real time: the main job
-# (scripts/main_job.sh: position staircase and sine, force steps, through `selfsense ctl`), then
+# (scripts/main_job.sh: position staircase and sine, force steps, through `selfsense ctl`; the
+# damping run; the self-heating run with and without adaptation), then
 # its figures, the recordings read back by the tool, a bad configuration refused with its
 # problems named, a reload, and SIGTERM to exit status 0. The main job watches the loop's state
 # (scripts/daemon_runs.sh): a run that faults (a pause of several ms of a shared machine) is
@@ -18,7 +19,7 @@ if [ -s "$out/faults.txt" ]; then
   echo "note: faulted runs, done again:"
   cat "$out/faults.txt"
 fi
-[ "$(grep -c 'selfsensed exited with status 0' "$out/main_job.out")" = 2 ] ||
+[ "$(grep -c 'selfsensed exited with status 0' "$out/main_job.out")" = 4 ] ||
   fail "a selfsensed did not exit 0 on SIGTERM: $(grep 'exited with status' "$out/main_job.out")"
 # Figures: the loop holds the self-sensed signal on the setpoint; the true one is off by the
 # model's error. Measured in ten runs (2026-11-26): S_hat 0.178-0.186 %, true S 0.210-0.219 %;
@@ -52,8 +53,28 @@ damped=$(sed -n 's/^damped: .* true S \([0-9.]*\) ms.*/\1/p' "$out/figures.txt")
 awk -v v="$damped" 'BEGIN { exit !(v > 0) }' || fail "no damped ring-down: '$damped' ms"
 echo "ok: ring-down of true S ${undamped} ms > 120 ms undamped, ${damped} ms > 0 damped"
 
+# The self-heating run (config/heating-sim.yaml: a 200 Hz sine in open loop warms the stack,
+# then position steps; docs/daemon.md, "Self-heating in the main job"). Measured in three runs
+# (2026-11-27, with the mount's prediction following the drift): the stack warmed by
+# 19.3-19.4 K; true S on the steps 0.724-0.784 % with adaptation (the issue's goal of 0.5 % is
+# not met: the estimate holds while the stack cools during the steps), 3.942-4.020 % without.
+# Asserted: the warming at least the issue's 15 K, the adapted figure under 1.3x the largest
+# seen (1.02 %), the unadapted one above the smallest / 1.3 (3.03 %: the warming is there to be
+# corrected).
+check heating-adapted S 1.02
+rise=$(sed -n 's/^self-heating: the sine warmed the stack by \([0-9.]*\) K.*/\1/p' "$out/figures.txt")
+[ -n "$rise" ] || fail "no self-heating figure in: $(cat "$out/figures.txt")"
+awk -v v="$rise" 'BEGIN { exit !(v >= 15) }' || fail "the sine warmed the stack by only $rise K"
+plain=$(sed -n 's/^heating-plain: .* true S \([0-9.]*\) % RMS.*/\1/p' "$out/figures.txt")
+awk -v v="$plain" 'BEGIN { exit !(v > 3.03) }' || fail "without adaptation true S is only '$plain' %"
+grep -q '^heating-adapted: .* equivalent 25.0 -> [0-9]' "$out/figures.txt" ||
+  fail "no equivalent temperature in the adapted run: $(grep '^heating-adapted' "$out/figures.txt")"
+echo "ok: self-heating by $rise K >= 15 K; true S without adaptation $plain % > 3.03 %"
+grep -q 'plant (true)' "$out/main_job.html" && grep -q 'equivalent (adaptation)' "$out/main_job.html" ||
+  fail "the page has no temperature plot"
+
 # The recordings are contract CSV: the tool reads them (reconstruct from E and D).
-for segment in position force undamped damped; do
+for segment in position force undamped damped heating-adapted; do
   rec=$(cat "$out/$segment.path")
   "$build/src/cli/selfsense" reconstruct --model "$root/config/models/sim.yaml" --recording "$rec" \
     --out "$out/$segment.reconstructed.csv" >/dev/null || fail "$rec is not a readable recording"

@@ -23,14 +23,15 @@ using testing::play_sine;
 using testing::RunningDaemon;
 using testing::warming_config;
 
-// Measured (docs/daemon.md, "Adaptation"); asserted at about 1.3x.
-constexpr double kMeasuredAdaptedS = 0.0101;       // S_hat nrmse, whole run (0.994-1.012 %)
-constexpr double kMeasuredAdaptedT = 0.0554;       // T_hat (5.40-5.54 %)
-constexpr double kMeasuredAdaptedLastS = 0.0138;   // last fifth (1.33-1.38 %)
-constexpr double kMeasuredAdaptedLastT = 0.0777;   // (7.55-7.77 %)
-constexpr double kMeasuredPlainS = 0.0402;         // without adaptation (4.02-4.11 %)
-constexpr double kMeasuredPlainT = 0.2125;         // (21.25-21.73 %)
-constexpr double kMeasuredTemperatureError = 3.9;  // [K] at the end (3.74-3.90 K)
+// Measured (docs/daemon.md, "Adaptation"); asserted at about 1.3x. The adapted figures since the
+// mount's prediction follows the drift (2026-11-27, four runs).
+constexpr double kMeasuredAdaptedS = 0.00758;      // S_hat nrmse, whole run (0.744-0.758 %)
+constexpr double kMeasuredAdaptedT = 0.0419;       // T_hat (4.10-4.19 %)
+constexpr double kMeasuredAdaptedLastS = 0.00943;  // last fifth (0.879-0.943 %)
+constexpr double kMeasuredAdaptedLastT = 0.0554;   // (5.26-5.54 %)
+constexpr double kMeasuredPlainS = 0.0402;         // without adaptation (4.02-4.14 %)
+constexpr double kMeasuredPlainT = 0.2125;         // (21.25-21.93 %)
+constexpr double kMeasuredTemperatureError = 2.5;  // [K] at the end (2.21-2.44 K)
 
 struct Errors {
   double s_nrmse{0.0};       // RMS(S_hat - S) / range(S)

@@ -17,11 +17,16 @@
 // load), so d' delta T is not noise but moves with delta E and would be learned as permittivity
 // (measured on the daemon's bench, r = 0.21: epsilon -7 % while the stack warmed by 20 K). With
 // the load's stiffness over the stack's, r = load_stiffness_ratio, the quasi-static stress of
-// the mount is predicted from the model's free strain S_free = y0_a + q_a E^2 + L_a + H_a:
-//   delta T = -kappa delta S,  delta S = delta S_free + s_a delta T,  kappa = r / s_a
-//   =>  T_mount = -(r / s_a) / (1 + r) S_free                                              [Pa]
-// and the estimator learns from D - d_s T_mount (constants cancel in its increments). r = 0:
-// the stress is taken as independent of the field (docs/adaptation.md).
+// the mount is predicted from the model's free strain as drifted so far (the drift before this
+// sample's update: c, lambda, s the coupling, loop and compliance changes),
+// S_free = y0_a + q_a E^2 + (1 + c) L_a + (1 + lambda) H_a:
+//   delta T = -kappa delta S,  delta S = delta S_free + (1 + s) s_a delta T,  kappa = r / s_a
+//   =>  T_mount = -kappa / (1 + (1 + s) r) S_free                                          [Pa]
+// and the estimator learns from D - (1 + c) d_s T_mount (constants cancel in its increments).
+// (With the undrifted free strain and coupling the mount's growing share of D as the stack
+// warms was read as a smaller permittivity change: docs/daemon.md, "Where the warming ramp's
+// error comes from".) r = 0: the stress is taken as independent of the field
+// (docs/adaptation.md).
 //
 // A sample whose inputs are not finite or outside the identification range (widened by
 // range_margin of its span) is rejected as models::Reconstruction rejects it: the operators
@@ -132,7 +137,9 @@ class AdaptedReconstruction final {
   Estimate last_{};
   models::StatusCounts counts_{};
   models::ModelIdentity identity_{};
-  double mount_gain_{0.0};  // -(r / s_a) / (1 + r) [Pa per unit free strain]
+  double mount_gain_{0.0};   // -(r / s_a) / (1 + r) [Pa per unit free strain]
+  double mount_ratio_{0.0};  // r
+  double mount_kappa_{0.0};  // r / s_a [Pa per unit strain]
 };
 
 }  // namespace selfsense::adaptation

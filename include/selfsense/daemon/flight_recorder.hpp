@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "selfsense/daemon/csv_row.hpp"
 #include "selfsense/daemon/recorder_config.hpp"
 #include "selfsense/runtime/loop_sample.hpp"
 
@@ -40,6 +41,9 @@ class FlightRecorder final {
   // when config.directory is empty.
   FlightRecorder(const FlightRecorderConfig& config, const std::filesystem::path& default_directory,
                  double sample_time_s, bool references, FaultNamer fault_namer = {});
+  // The same with the recording's columns (RowFormat: references, temperatures).
+  FlightRecorder(const FlightRecorderConfig& config, const std::filesystem::path& default_directory,
+                 double sample_time_s, RowFormat format, FaultNamer fault_namer = {});
 
   void add(const runtime::LoopSample& sample) noexcept;
   [[nodiscard]] std::size_t size() const noexcept { return count_; }
@@ -64,7 +68,7 @@ class FlightRecorder final {
   FlightRecorderConfig config_;
   std::filesystem::path directory_;
   double sample_time_s_{0.0};
-  bool references_{true};
+  RowFormat format_{true};
   FaultNamer fault_namer_;
   std::vector<runtime::LoopSample> history_;
   std::size_t next_{0};

@@ -26,6 +26,8 @@ struct RecorderConfig {
   double flush_period_ms{500.0};  // written rows reach the disk (fdatasync) at least this often
   std::size_t ring_capacity{std::size_t{1} << 16U};  // samples between loop and writer
   bool references{true};                             // write the reference columns S and T
+  bool temperature{false};             // write `temp` (the driver's stack temperature, degC)
+  bool temperature_equivalent{false};  // write `temp_equivalent` (the adaptation's, degC)
   double sample_time_s{1e-4};  // the loop's period, for the header comment and flight recorder
   std::vector<std::string> comments{};  // extra '#' lines for every file (config name, model)
   FlightRecorderConfig flight{};

@@ -39,6 +39,15 @@ struct MainJobRun {
   std::vector<double> reference{};  // S [-] or T [Pa], the plant's truth
   std::vector<double> field{};      // E [V/m]
   std::vector<double> state{};      // 0 faulted, 1 ready, 2 armed
+  // The control mode (0 position, 2 open-loop); empty when not recorded. A position run's
+  // tracking error counts position-mode samples only (the self-heating run warms the stack in
+  // open loop first).
+  std::vector<double> mode{};
+  // The self-heating run's temperatures [degC], empty when not recorded: the plant's stack
+  // (`temp`) and the adaptation's equivalent temperature (`temp_equivalent`). With either, a
+  // tracking run also plots them and the self-sensing error (estimate - reference).
+  std::vector<double> temperature{};
+  std::vector<double> temperature_estimate{};
   // The first faulted sample: its time and what latched ("overrun at cycle 65783").
   double fault_t{std::numeric_limits<double>::quiet_NaN()};
   std::string fault_text{};

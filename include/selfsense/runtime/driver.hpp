@@ -42,6 +42,7 @@ struct InputSample {
   double d{kNone};                 // D [C/m^2]
   double s_ref{kNone};             // S [-] from a reference sensor, NaN without one
   double t_ref{kNone};             // T [Pa] from a reference sensor, NaN without one
+  double temp_ref{kNone};          // the stack's temperature [degC], NaN without a sensor
   std::int64_t timestamp_ns{0};    // sampling instant on the loop's clock
   std::uint16_t device_status{0};  // the device's own status bits, for the recording
 };
@@ -130,6 +131,8 @@ class Driver {
 
   // Whether read() fills s_ref and t_ref.
   [[nodiscard]] virtual bool has_references() const noexcept { return false; }
+  // Whether read() fills temp_ref (the recording's `temp` column).
+  [[nodiscard]] virtual bool has_temperature() const noexcept { return false; }
   // Every counter the driver keeps, the common ones and its own (events). The loop calls it on
   // its real-time thread every status_period cycles for the status snapshot: real-time safe
   // (loads of atomics, nothing allocated, no lock), and the same event names in the same order

@@ -42,6 +42,8 @@ struct LoopSample {
   double command{kNone};           // amplifier command as field E [V/m] after limits
   double s_ref{kNone};             // S [-] from a reference sensor, NaN without one
   double t_ref{kNone};             // T [Pa] from a reference sensor, NaN without one
+  double temp_ref{kNone};          // the stack's temperature [degC] from the driver, or NaN
+  double temp_equivalent{kNone};   // the adaptation's equivalent temperature [degC], or NaN
   std::uint32_t faults{0};         // bit set of runtime::Fault (latched)
   std::uint16_t driver_status{0};  // the driver's per-sample status word
   LoopState state{LoopState::kFaulted};

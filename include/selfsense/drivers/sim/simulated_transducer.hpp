@@ -60,6 +60,11 @@ class SimulatedTransducer final : public runtime::Driver, public runtime::ForceI
   runtime::DriverStatus write(const runtime::OutputCommand& command) noexcept override;
   void deactivate() noexcept override;
   [[nodiscard]] bool has_references() const noexcept override { return true; }
+  // The stack's temperature (the ramp and swing, with the self-heating) when the plant models
+  // temperature or heats itself.
+  [[nodiscard]] bool has_temperature() const noexcept override {
+    return config_.temperature.enabled || config_.heating.enabled;
+  }
   [[nodiscard]] runtime::DriverCounters counters() const noexcept override;
   [[nodiscard]] runtime::ForceInput* force_input() noexcept override { return this; }
   // A force pulse on the stack (ForceInput), on top of set_external_force(); any thread.
