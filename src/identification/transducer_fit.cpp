@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <span>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "selfsense/identification/fit_quality.hpp"
@@ -42,12 +44,21 @@ class SizeChooser {
       head_.linear_inputs.push_back(u.first(split_));
   }
 
+  // Only the dead zones and the hinges vary between candidates: a pair judged before (the
+  // chosen dead zones with the hinges they were judged with are the first hinge candidate
+  // again) is not fitted twice.
   [[nodiscard]] double tail_rss(const OperatorStructure& structure) {
+    const std::array<std::size_t, 2> key{structure.dead_zones, structure.bias_levels};
+    for (const auto& [judged, rss] : judged_) {
+      if (judged == key) return rss;
+    }
     simulate_operator(fit_operator(head_, structure), s_.input, s_.linear_inputs, y_);
     double rss = 0.0;
     for (std::size_t k = split_; k < y_.size(); ++k)
       rss += (y_[k] - s_.output[k]) * (y_[k] - s_.output[k]);
-    return std::isfinite(rss) ? rss : std::numeric_limits<double>::infinity();
+    if (!std::isfinite(rss)) rss = std::numeric_limits<double>::infinity();
+    judged_.emplace_back(key, rss);
+    return rss;
   }
 
   // The candidate value of `field` with the smallest tail error (the first one on ties).
@@ -72,6 +83,7 @@ class SizeChooser {
   std::size_t split_;
   OperatorSignals head_{};
   std::vector<double> y_;
+  std::vector<std::pair<std::array<std::size_t, 2>, double>> judged_{};
 };
 
 OperatorModel fit_side(const OperatorSignals& s, OperatorStructure structure,
@@ -199,9 +211,18 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
   const bool creep =
       structure == Structure::kHysteresisCreep || structure == Structure::kPreisachCreep;
   const bool choose = structure == Structure::kPreisachCreep;
+  // The sides share nothing but the signals they read: with both recorded, the sensor side is
+  // fitted on a second thread while this one fits the actuator side (the same fits, in the same
+  // order each, as one after the other). Declared after what the fit reads, so that an exception
+  // here waits for it before those go.
+  std::future<OperatorModel> sensor;
   if (usable(signals.sensed)) {
-    model.sensor = fit_side({signals.drive, linear, signals.sensed, signals.sample_time},
-                            structure_of(options, creep), options, choose);
+    const auto fit_sensor = [&] {
+      return fit_side({signals.drive, linear, signals.sensed, signals.sample_time},
+                      structure_of(options, creep), options, choose);
+    };
+    sensor = usable(signals.strain) ? std::async(std::launch::async, fit_sensor)
+                                    : std::async(std::launch::deferred, fit_sensor);
   }
   if (usable(signals.strain)) {
     // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19);
@@ -225,6 +246,7 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
       model.actuator->linear_gains.pop_back();
     }
   }
+  if (sensor.valid()) model.sensor = sensor.get();
   return model;
 }
 
