@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <future>
+#include <functional>
 #include <limits>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <utility>
@@ -177,7 +178,7 @@ IdentificationOptions defaults_for(Structure s) noexcept {
 }
 
 TransducerModel identify(const TransducerSignals& signals, Structure structure,
-                         const IdentificationOptions& options) {
+                         const IdentificationOptions& options, const WorkRunner& run) {
   const std::size_t n = signals.drive.size();
   const auto usable = [n](std::span<const double> s) { return !s.empty() && s.size() == n; };
   if (n < 2) throw std::invalid_argument("identify: the drive signal needs at least 2 samples");
@@ -211,42 +212,48 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
   const bool creep =
       structure == Structure::kHysteresisCreep || structure == Structure::kPreisachCreep;
   const bool choose = structure == Structure::kPreisachCreep;
-  // The sides share nothing but the signals they read: with both recorded, the sensor side is
-  // fitted on a second thread while this one fits the actuator side (the same fits, in the same
-  // order each, as one after the other). Declared after what the fit reads, so that an exception
-  // here waits for it before those go.
-  std::future<OperatorModel> sensor;
+  // The sides share nothing but the signals they read: each is one piece of work for `run`.
+  std::optional<OperatorModel> sensor;
+  std::optional<OperatorModel> actuator;
+  std::vector<double> squared;
+  std::vector<std::span<const double>> actuator_inputs = linear;
+  // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19); with
+  // charge drive it also has the electrostrictive term S ~ D^2, which makes the butterfly strain
+  // loops of bipolar drive past the coercive field.
+  const bool linear_side =
+      structure == Structure::kPermittivity || structure == Structure::kChargeDrive;
+  if (usable(signals.strain) && structure == Structure::kChargeDrive) {
+    squared.resize(n);
+    for (std::size_t k = 0; k < n; ++k)
+      squared[k] = signals.drive[k] * signals.drive[k];
+    actuator_inputs.emplace_back(squared);
+  }
+  std::vector<std::function<void()>> work;
   if (usable(signals.sensed)) {
-    const auto fit_sensor = [&] {
-      return fit_side({signals.drive, linear, signals.sensed, signals.sample_time},
-                      structure_of(options, creep), options, choose);
-    };
-    sensor = usable(signals.strain) ? std::async(std::launch::async, fit_sensor)
-                                    : std::async(std::launch::deferred, fit_sensor);
+    work.emplace_back([&] {
+      sensor = fit_side({signals.drive, linear, signals.sensed, signals.sample_time},
+                        structure_of(options, creep), options, choose);
+    });
   }
   if (usable(signals.strain)) {
-    // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19);
-    // with charge drive it also has the electrostrictive term S ~ D^2, which makes the
-    // butterfly strain loops of bipolar drive past the coercive field.
-    const bool linear_side =
-        structure == Structure::kPermittivity || structure == Structure::kChargeDrive;
-    std::vector<double> squared;
-    std::vector<std::span<const double>> inputs = linear;
-    if (structure == Structure::kChargeDrive) {
-      squared.resize(n);
-      for (std::size_t k = 0; k < n; ++k)
-        squared[k] = signals.drive[k] * signals.drive[k];
-      inputs.emplace_back(squared);
-    }
-    model.actuator = fit_side({signals.drive, inputs, signals.strain, signals.sample_time},
-                              linear_side ? OperatorStructure{} : structure_of(options, creep),
-                              options, choose && !linear_side);
-    if (!squared.empty()) {
-      model.actuator->quadratic = model.actuator->linear_gains.back();
-      model.actuator->linear_gains.pop_back();
-    }
+    work.emplace_back([&] {
+      actuator = fit_side({signals.drive, actuator_inputs, signals.strain, signals.sample_time},
+                          linear_side ? OperatorStructure{} : structure_of(options, creep), options,
+                          choose && !linear_side);
+    });
   }
-  if (sensor.valid()) model.sensor = sensor.get();
+  if (run && work.size() > 1) {
+    run(work);
+  } else {
+    for (const auto& piece : work)
+      piece();
+  }
+  model.sensor = std::move(sensor);
+  model.actuator = std::move(actuator);
+  if (model.actuator && !squared.empty()) {
+    model.actuator->quadratic = model.actuator->linear_gains.back();
+    model.actuator->linear_gains.pop_back();
+  }
   return model;
 }
 
