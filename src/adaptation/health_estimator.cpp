@@ -9,7 +9,7 @@ namespace selfsense::adaptation {
 
 namespace {
 
-bool fail(std::string* why, const std::string& message) {
+bool reject(std::string* why, const std::string& message) {
   if (why != nullptr) *why = message;
   return false;
 }
@@ -30,33 +30,33 @@ bool HealthEstimatorConfig::is_valid(const std::string& prefix, std::string* why
                   {"slope_time_s", slope_time_s}};
   for (const auto& p : positive) {
     if (!(std::isfinite(p.value) && p.value > 0.0)) {
-      return fail(why, prefix + p.key + ": must be finite and > 0");
+      return reject(why, prefix + p.key + ": must be finite and > 0");
     }
   }
   if (!(std::isfinite(hold_settle_s) && hold_settle_s >= 0.0)) {
-    return fail(why, prefix + "hold_settle_s: must be finite and >= 0");
+    return reject(why, prefix + "hold_settle_s: must be finite and >= 0");
   }
   if (!(std::isfinite(settle_s) && settle_s >= 0.0)) {
-    return fail(why, prefix + "settle_s: must be finite and >= 0");
+    return reject(why, prefix + "settle_s: must be finite and >= 0");
   }
   if (!(slope_time_s > trend_time_s)) {
-    return fail(why, prefix + "slope_time_s: must be > trend_time_s");
+    return reject(why, prefix + "slope_time_s: must be > trend_time_s");
   }
-  if (baseline_cycles < 1) return fail(why, prefix + "baseline_cycles: must be >= 1");
+  if (baseline_cycles < 1) return reject(why, prefix + "baseline_cycles: must be >= 1");
   if (!(span_tolerance > 0.0 && span_tolerance < 1.0)) {
-    return fail(why, prefix + "span_tolerance: must be in (0, 1)");
+    return reject(why, prefix + "span_tolerance: must be in (0, 1)");
   }
   if (!std::isfinite(capacitance_per_k) || capacitance_per_k == 0.0) {
-    return fail(why, prefix + "capacitance_per_k: must be finite and not 0");
+    return reject(why, prefix + "capacitance_per_k: must be finite and not 0");
   }
   if (!std::isfinite(dissipation_per_k)) {
-    return fail(why, prefix + "dissipation_per_k: must be finite");
+    return reject(why, prefix + "dissipation_per_k: must be finite");
   }
   if (!(depolarisation_sensitivity > 0.0 && depolarisation_sensitivity <= 2.0)) {
-    return fail(why, prefix + "depolarisation_sensitivity: must be in (0, 2]");
+    return reject(why, prefix + "depolarisation_sensitivity: must be in (0, 2]");
   }
   if (!(max_span_change > 0.0 && max_span_change <= 1.0)) {
-    return fail(why, prefix + "max_span_change: must be in (0, 1]");
+    return reject(why, prefix + "max_span_change: must be in (0, 1]");
   }
   return true;
 }

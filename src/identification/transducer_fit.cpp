@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <optional>
 #include <span>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "selfsense/identification/fit_quality.hpp"
@@ -42,12 +45,21 @@ class SizeChooser {
       head_.linear_inputs.push_back(u.first(split_));
   }
 
+  // Only the dead zones and the hinges vary between candidates: a pair judged before (the
+  // chosen dead zones with the hinges they were judged with are the first hinge candidate
+  // again) is not fitted twice.
   [[nodiscard]] double tail_rss(const OperatorStructure& structure) {
+    const std::array<std::size_t, 2> key{structure.dead_zones, structure.bias_levels};
+    for (const auto& [judged, rss] : judged_) {
+      if (judged == key) return rss;
+    }
     simulate_operator(fit_operator(head_, structure), s_.input, s_.linear_inputs, y_);
     double rss = 0.0;
     for (std::size_t k = split_; k < y_.size(); ++k)
       rss += (y_[k] - s_.output[k]) * (y_[k] - s_.output[k]);
-    return std::isfinite(rss) ? rss : std::numeric_limits<double>::infinity();
+    if (!std::isfinite(rss)) rss = std::numeric_limits<double>::infinity();
+    judged_.emplace_back(key, rss);
+    return rss;
   }
 
   // The candidate value of `field` with the smallest tail error (the first one on ties).
@@ -72,6 +84,7 @@ class SizeChooser {
   std::size_t split_;
   OperatorSignals head_{};
   std::vector<double> y_;
+  std::vector<std::pair<std::array<std::size_t, 2>, double>> judged_{};
 };
 
 OperatorModel fit_side(const OperatorSignals& s, OperatorStructure structure,
@@ -165,7 +178,7 @@ IdentificationOptions defaults_for(Structure s) noexcept {
 }
 
 TransducerModel identify(const TransducerSignals& signals, Structure structure,
-                         const IdentificationOptions& options) {
+                         const IdentificationOptions& options, const WorkRunner& run) {
   const std::size_t n = signals.drive.size();
   const auto usable = [n](std::span<const double> s) { return !s.empty() && s.size() == n; };
   if (n < 2) throw std::invalid_argument("identify: the drive signal needs at least 2 samples");
@@ -199,31 +212,47 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
   const bool creep =
       structure == Structure::kHysteresisCreep || structure == Structure::kPreisachCreep;
   const bool choose = structure == Structure::kPreisachCreep;
+  // The sides share nothing but the signals they read: each is one piece of work for `run`.
+  std::optional<OperatorModel> sensor;
+  std::optional<OperatorModel> actuator;
+  std::vector<double> squared;
+  std::vector<std::span<const double>> actuator_inputs = linear;
+  // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19); with
+  // charge drive it also has the electrostrictive term S ~ D^2, which makes the butterfly strain
+  // loops of bipolar drive past the coercive field.
+  const bool linear_side =
+      structure == Structure::kPermittivity || structure == Structure::kChargeDrive;
+  if (usable(signals.strain) && structure == Structure::kChargeDrive) {
+    squared.resize(n);
+    for (std::size_t k = 0; k < n; ++k)
+      squared[k] = signals.drive[k] * signals.drive[k];
+    actuator_inputs.emplace_back(squared);
+  }
+  std::vector<std::function<void()>> work;
   if (usable(signals.sensed)) {
-    model.sensor = fit_side({signals.drive, linear, signals.sensed, signals.sample_time},
-                            structure_of(options, creep), options, choose);
+    work.emplace_back([&] {
+      sensor = fit_side({signals.drive, linear, signals.sensed, signals.sample_time},
+                        structure_of(options, creep), options, choose);
+    });
   }
   if (usable(signals.strain)) {
-    // The actuator side of the permittivity and charge-drive models is linear (eq. 6, 19);
-    // with charge drive it also has the electrostrictive term S ~ D^2, which makes the
-    // butterfly strain loops of bipolar drive past the coercive field.
-    const bool linear_side =
-        structure == Structure::kPermittivity || structure == Structure::kChargeDrive;
-    std::vector<double> squared;
-    std::vector<std::span<const double>> inputs = linear;
-    if (structure == Structure::kChargeDrive) {
-      squared.resize(n);
-      for (std::size_t k = 0; k < n; ++k)
-        squared[k] = signals.drive[k] * signals.drive[k];
-      inputs.emplace_back(squared);
-    }
-    model.actuator = fit_side({signals.drive, inputs, signals.strain, signals.sample_time},
-                              linear_side ? OperatorStructure{} : structure_of(options, creep),
-                              options, choose && !linear_side);
-    if (!squared.empty()) {
-      model.actuator->quadratic = model.actuator->linear_gains.back();
-      model.actuator->linear_gains.pop_back();
-    }
+    work.emplace_back([&] {
+      actuator = fit_side({signals.drive, actuator_inputs, signals.strain, signals.sample_time},
+                          linear_side ? OperatorStructure{} : structure_of(options, creep), options,
+                          choose && !linear_side);
+    });
+  }
+  if (run && work.size() > 1) {
+    run(work);
+  } else {
+    for (const auto& piece : work)
+      piece();
+  }
+  model.sensor = std::move(sensor);
+  model.actuator = std::move(actuator);
+  if (model.actuator && !squared.empty()) {
+    model.actuator->quadratic = model.actuator->linear_gains.back();
+    model.actuator->linear_gains.pop_back();
   }
   return model;
 }

@@ -12,7 +12,7 @@
 namespace selfsense::models {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 
 // The model with its sides discretised for the loop's sample time.
 TransducerModel at_sample_time(TransducerModel model, double ts) {
@@ -261,7 +261,7 @@ Reconstruction::Reconstruction(const TransducerModel& model, const RuntimeOption
       gate_(model.drive_range, model.sensed_range, options.range_margin),
       sample_time_(loop_sample_time(model, options)),
       identified_ts_(model.sample_time),
-      last_{0.0, kNaN, SampleStatus::kOk},
+      last_{0.0, kNoValue, SampleStatus::kOk},
       sensed_fix_(stage_for(model.sensed_correction, sample_time_)),
       strain_fix_(stage_for(without_delay(model.strain_correction), sample_time_)),
       temperature_(reference_temperature(model)),
@@ -392,7 +392,7 @@ Simulation::Simulation(const TransducerModel& model, const RuntimeOptions& optio
       gate_(model.drive_range, std::nullopt, options.range_margin),
       sample_time_(loop_sample_time(model, options)),
       identified_ts_(model.sample_time),
-      last_{kNaN, kNaN, SampleStatus::kOk},
+      last_{kNoValue, kNoValue, SampleStatus::kOk},
       sensed_fix_(stage_for(model.sensed_correction, sample_time_)),
       strain_fix_(stage_for(model.strain_correction, sample_time_)),
       temperature_(reference_temperature(model)),

@@ -12,7 +12,7 @@
 namespace selfsense::report {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kNoValue = std::numeric_limits<double>::quiet_NaN();
 constexpr int kWidth = 980;
 constexpr int kLegendColumn = 230;
 constexpr int kMainHeight = 300;
@@ -37,7 +37,7 @@ constexpr std::string_view kReadyColour = "#999999";
 constexpr std::string_view kMarkerColour = "#8b0000";
 constexpr std::string_view kZeroColour = "#888888";
 
-constexpr std::string_view kStyle = R"(
+constexpr std::string_view kPageStyle = R"(
 body { font-family: "DejaVu Sans", Arial, sans-serif; margin: 16px 24px; color: #222;
        max-width: 1200px; }
 h1 { font-size: 22px; margin: 0 0 8px; }
@@ -95,7 +95,7 @@ void mark_states(SvgPlot& plot, const MainJobRun& run) {
   }
 }
 
-std::string figure(const SvgPlot& plot, const std::string& caption) {
+std::string page_figure(const SvgPlot& plot, const std::string& caption) {
   std::string out = "<figure>\n" + plot.render();
   if (!caption.empty()) out += "<figcaption>" + caption + "</figcaption>\n";
   return out + "</figure>\n";
@@ -127,7 +127,7 @@ std::string temperature_plots(const MainJobRun& run, std::span<const double> t) 
     mark_states(err, run);
     err.add_reference("", 0.0, std::string(kZeroColour));
     err.add_line(q.symbol + "_hat - " + q.symbol, t, error, std::string(kEstimateColour));
-    out += figure(err,
+    out += page_figure(err,
                   "The estimate against the plant's truth over every sample, the fast sine "
                   "that warms the stack included.");
   }
@@ -145,7 +145,7 @@ std::string temperature_plots(const MainJobRun& run, std::span<const double> t) 
                   std::string(kEquivalentColour));
   }
   out +=
-      figure(temp, std::string("Red: the simulated stack's temperature (the plant's self-heating, "
+      page_figure(temp, std::string("Red: the simulated stack's temperature (the plant's self-heating, "
                                "never seen by the loop)") +
                        (has_equivalent ? "; blue: the equivalent temperature the adaptation "
                                          "learns from E and D alone."
@@ -173,7 +173,7 @@ std::string tracking_plots(const MainJobRun& run) {
                   scaled(std::span<const double>(run.reference).first(n), q.scale),
                   std::string(kReferenceColour));
   }
-  std::string out = figure(
+  std::string out = page_figure(
       main, "Black: the setpoint; blue: " + hat +
                 ", the loop's self-sensed estimate from E and D only; red: " + q.symbol +
                 ", the simulated plant's truth, never seen by the loop." + fault_caption(run));
@@ -183,8 +183,8 @@ std::string tracking_plots(const MainJobRun& run) {
     for (std::size_t i = 0; i < n; ++i)
       settled[i] = settled[i] && run.mode[i] == kModePosition;
   }
-  std::vector<double> error_hat(n, kNaN);
-  std::vector<double> error_true(n, kNaN);
+  std::vector<double> error_hat(n, kNoValue);
+  std::vector<double> error_true(n, kNoValue);
   for (std::size_t i = 0; i < n; ++i) {
     if (!settled[i]) continue;
     error_hat[i] = q.scale * (estimate[i] - setpoint[i]);
@@ -203,7 +203,7 @@ std::string tracking_plots(const MainJobRun& run) {
   if (has_reference) {
     error.add_line(q.symbol + " - setpoint", t, error_true, std::string(kReferenceColour));
   }
-  out += figure(error, "The error the figures measure: over the armed samples from " +
+  out += page_figure(error, "The error the figures measure: over the armed samples from " +
                            format_number(kSettleTime) + " s after each setpoint step on" +
                            (run.kind == MainJobRun::Kind::kPosition ? ", in position mode" : "") +
                            " (the gaps are the samples not counted).");
@@ -216,7 +216,7 @@ std::string tracking_plots(const MainJobRun& run) {
     mark_states(field, run);
     field.add_line("E", t, scaled(std::span<const double>(run.field).first(n), kMegaPerUnit),
                    std::string(kFieldColour));
-    out += figure(field, "");
+    out += page_figure(field, "");
   }
   return out;
 }
@@ -251,7 +251,7 @@ std::string ring_down_plots(const MainJobRun& run) {
                     " s before the largest deviation; the rest: the mean of the last 40 % of "
                     "the armed samples. Red: true S; blue: S_hat, the signal the loop damps."
               : "No armed sample: the whole recording, S and S_hat as recorded.";
-  std::string out = figure(main, caption + fault_caption(run));
+  std::string out = page_figure(main, caption + fault_caption(run));
   if (has_reference) {
     SvgPlot err(run.heading + ": self-sensing error", std::string(kTimeLabel), "S_hat - S [1e-6]",
                 kWidth, kErrorHeight);
@@ -263,7 +263,7 @@ std::string ring_down_plots(const MainJobRun& run) {
     mark_states(err, run);
     err.add_reference("", 0.0, std::string(kZeroColour));
     err.add_line("S_hat - S", t, error, std::string(kEstimateColour));
-    out += figure(err, "The estimate's error against the plant's truth in the same window.");
+    out += page_figure(err, "The estimate's error against the plant's truth in the same window.");
   }
   return out;
 }
@@ -351,7 +351,7 @@ std::string main_job_page_html(const MainJobPage& page) {
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; "
       "style-src 'unsafe-inline'\">\n<title>selfsense main job</title>\n<style>" +
-      std::string(kStyle) + std::string(plot_style()) + "</style>\n</head>\n<body>\n<h1>" +
+      std::string(kPageStyle) + std::string(plot_style()) + "</style>\n</head>\n<body>\n<h1>" +
       escape_html(page.title) + "</h1>\n";
   if (!page.fault_lines.empty()) {
     html += "<h2>faulted runs, done again</h2>\n<ul>\n";

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <span>
 
 #include "selfsense/models/transducer_model.hpp"
@@ -52,9 +53,17 @@ struct TransducerSignals {
   double sample_time{0.0};
 };
 
+// Runs independent pieces of work and returns when each has run, rethrowing an exception one of
+// them threw. identify() hands it the fits of the two sides, which share nothing but the
+// signals they read. This library runs no threads (docs/architecture.md): a program that may
+// passes a runner that runs the pieces in parallel (`selfsense identify`); without one they run
+// one after the other. Either way the same fits, so the same model.
+using WorkRunner = std::function<void(std::span<const std::function<void()>>)>;
+
 // Fits the sides the signals allow. Throws std::invalid_argument on unusable signals (no drive,
 // neither sensed nor strain, mismatched lengths).
 [[nodiscard]] TransducerModel identify(const TransducerSignals& signals, Structure structure,
-                                       const IdentificationOptions& options);
+                                       const IdentificationOptions& options,
+                                       const WorkRunner& run = {});
 
 }  // namespace selfsense::identification
