@@ -128,8 +128,8 @@ std::string temperature_plots(const MainJobRun& run, std::span<const double> t) 
     err.add_reference("", 0.0, std::string(kZeroColour));
     err.add_line(q.symbol + "_hat - " + q.symbol, t, error, std::string(kEstimateColour));
     out += page_figure(err,
-                  "The estimate against the plant's truth over every sample, the fast sine "
-                  "that warms the stack included.");
+                       "The estimate against the plant's truth over every sample, the fast sine "
+                       "that warms the stack included.");
   }
   SvgPlot temp(run.heading + ": the stack's temperature", std::string(kTimeLabel),
                "temperature [degC]", kWidth, kTemperatureHeight);
@@ -144,12 +144,12 @@ std::string temperature_plots(const MainJobRun& run, std::span<const double> t) 
                   std::span<const double>(run.temperature_estimate).first(n),
                   std::string(kEquivalentColour));
   }
-  out +=
-      page_figure(temp, std::string("Red: the simulated stack's temperature (the plant's self-heating, "
-                               "never seen by the loop)") +
-                       (has_equivalent ? "; blue: the equivalent temperature the adaptation "
-                                         "learns from E and D alone."
-                                       : "; this run does not adapt."));
+  out += page_figure(
+      temp, std::string("Red: the simulated stack's temperature (the plant's self-heating, "
+                        "never seen by the loop)") +
+                (has_equivalent ? "; blue: the equivalent temperature the adaptation "
+                                  "learns from E and D alone."
+                                : "; this run does not adapt."));
   return out;
 }
 
@@ -203,10 +203,11 @@ std::string tracking_plots(const MainJobRun& run) {
   if (has_reference) {
     error.add_line(q.symbol + " - setpoint", t, error_true, std::string(kReferenceColour));
   }
-  out += page_figure(error, "The error the figures measure: over the armed samples from " +
-                           format_number(kSettleTime) + " s after each setpoint step on" +
-                           (run.kind == MainJobRun::Kind::kPosition ? ", in position mode" : "") +
-                           " (the gaps are the samples not counted).");
+  out +=
+      page_figure(error, "The error the figures measure: over the armed samples from " +
+                             format_number(kSettleTime) + " s after each setpoint step on" +
+                             (run.kind == MainJobRun::Kind::kPosition ? ", in position mode" : "") +
+                             " (the gaps are the samples not counted).");
 
   out += temperature_plots(run, t);
   if (run.field.size() >= n) {

@@ -432,9 +432,11 @@ TEST(ConcealedEffectHolds, CreepAfterLargeStepsIsNamedOnHeldOutHolds) {
 // A base identified on the very recording it is diagnosed on (the user's usual case) has absorbed
 // what its own terms can imitate: its residual is orthogonal to them over the record, so the
 // coupling's change with stress, fitted on the fitting blocks alone, loses on the held-out ones
-// (the first rounds name nothing). Fitted beside a refit of the model's own loop it is named, and
-// the improved model predicts a recording with new excitation better. The same bench without
-// the effect names nothing.
+// (the first rounds name nothing). Fitted beside a refit of the model's own loop it is named
+// (validation S 2.48 -> 0.911 %); the stress-hysteresis structure, cross-validated over the
+// record's halves, explains more of S (97 %) and is taken since it may replace a channel's
+// findings where it explains more (docs/diagnose.md): 2.48 -> 0.33 %. Either way the finding says
+// the base took the stress in. The same bench without the effect names nothing.
 TEST(ConcealedEffectAbsorbed, StressCouplingInTheBaseIsNamedBesideItsOwnLoop) {
   plant::PlantConfig p = base_plant();
   plant::ExcitationConfig x = fitting_excitation();
@@ -454,8 +456,10 @@ TEST(ConcealedEffectAbsorbed, StressCouplingInTheBaseIsNamedBesideItsOwnLoop) {
         return f.effect == "stress_dependence" && f.channel == "S";
       });
   ASSERT_NE(named, result.findings.end());
-  EXPECT_NE(named->evidence.find("absorbed"), std::string::npos) << named->evidence;
-  EXPECT_LE(after, 0.5 * before);  // measured 2.48 % -> 0.911 %
+  EXPECT_TRUE(named->evidence.find("absorbed") != std::string::npos ||
+              named->evidence.find("bent its own operators") != std::string::npos)
+      << named->evidence;
+  EXPECT_LE(after, 0.18 * before);  // measured 2.48 % -> 0.33 % (0.133x)
 
   const Recorded clean = record(base_plant(), fitting_excitation(), 41);
   EXPECT_FALSE(diagnosis::diagnose(identified_on(clean), clean.signals()).mismatch);
