@@ -91,7 +91,6 @@ AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& mode
           "adaptation.load_stiffness_ratio: needs a model with an actuator side and a compliance"};
     }
     const double r = config.load_stiffness_ratio;
-    mount_gain_ = -(r / kernel_.actuator()->coupling()) / (1.0 + r);
     mount_ratio_ = r;
     mount_kappa_ = r / kernel_.actuator()->coupling();
   }
@@ -130,7 +129,9 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field,
     fixed_a = a.offset() + a.quadratic() * field * field;
     pa = actuator_split_->split(a, field, a.step_unloaded(field) - fixed_a);
   }
-  const double mount_stress = mount_gain_ * (fixed_a + pa.linear + pa.loop);  // header comment
+  // The mount's stress from the stack as identified (header comment), for the model's own D.
+  const double mount_stress =
+      -mount_kappa_ / (1.0 + mount_ratio_) * (fixed_a + pa.linear + pa.loop);
   // The mount's share of D as the stack is now: the free strain, the stiffness ratio and the
   // sensor's coupling with the drift learned so far.
   const Drift now = estimator_.drift();

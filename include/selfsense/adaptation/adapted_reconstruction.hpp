@@ -137,7 +137,6 @@ class AdaptedReconstruction final {
   Estimate last_{};
   models::StatusCounts counts_{};
   models::ModelIdentity identity_{};
-  double mount_gain_{0.0};   // -(r / s_a) / (1 + r) [Pa per unit free strain]
   double mount_ratio_{0.0};  // r
   double mount_kappa_{0.0};  // r / s_a [Pa per unit strain]
 };
