@@ -51,12 +51,20 @@ BlockShares block_explains(std::span<const double> recorded, const std::vector<d
     mean += e / static_cast<double>(held0.size());
   for (std::size_t i = 0; i < held0.size(); ++i)
     out.worst = std::min(out.worst, (held0[i] - held1[i]) / std::max(held0[i], mean));
+  double sum0 = 0.0;
+  double sum1 = 0.0;
+  for (std::size_t i = 0; i < held0.size(); ++i) {
+    sum0 += held0[i];
+    sum1 += held1[i];
+  }
+  out.explains = sum0 > 0.0 ? 1.0 - sum1 / sum0 : 0.0;
   out.test = paired_gain_test(held0, held1);
   return out;
 }
 
 bool passes_blocks(const BlockShares& shares, const Options& options) {
-  return shares.test.significant && shares.worst >= -options.max_block_loss;
+  return shares.test.significant &&
+         shares.worst >= -std::max(options.max_block_loss, shares.explains);
 }
 
 double sse_over(std::span<const double> recorded, const std::vector<double>& model,

@@ -31,13 +31,17 @@ struct Rows {
 // it makes some stretch worse (a term that does will not carry over to new data either).
 struct BlockShares {
   GainTest test{};
-  double worst{0.0};  // the largest loss of one block, relative to max(its own, the mean block)
+  double worst{0.0};     // the largest loss of one block, relative to max(its own, the mean block)
+  double explains{0.0};  // 1 - sum after / sum before over the judged blocks
 };
 [[nodiscard]] BlockShares block_explains(std::span<const double> recorded,
                                          const std::vector<double>& before,
                                          const std::vector<double>& after, const Rows& rows);
 
-// The block test: a significant gain over the held-out blocks, none worse by `max_block_loss`.
+// The block test: a significant gain over the held-out blocks, and none worse by more than the
+// larger of `max_block_loss` and the share the candidate removes over all of them together
+// (shares.explains): a strong effect may leave one stretch as much worse as it makes the
+// record better on average, a weak one no more than max_block_loss.
 [[nodiscard]] bool passes_blocks(const BlockShares& shares, const Options& options);
 
 // Sum of squared errors over the marked rows, and over a segment.

@@ -49,7 +49,8 @@ struct Signals {
 struct Options {
   double min_explains{0.3};  // share of held-out residual variance an effect must remove
   double min_share{0.02};    // ... and at least this share of the channel's first residual
-  // ... and in no held-out block may it add more than this share to the residual variance.
+  // ... and in no held-out block may it add more than this share to the residual variance, or
+  // than the share it removes over all held-out blocks together where that is larger.
   double max_block_loss{0.2};
   double alternative_share{0.8};  // alternatives: explain at least this share of the best's
   // A simpler candidate wins when the residual it leaves is at most this factor of the best's.
