@@ -54,7 +54,7 @@ awk -v v="$damped" 'BEGIN { exit !(v > 0) }' || fail "no damped ring-down: '$dam
 echo "ok: ring-down of true S ${undamped} ms > 120 ms undamped, ${damped} ms > 0 damped"
 
 # The self-heating run (config/heating-sim.yaml: a 200 Hz sine in open loop warms the stack,
-# then position steps; docs/daemon.md, "Self-heating in the main job"). Measured in five runs
+# then position steps; docs/daemon.md, "Self-heating in the main job"). Measured in six runs
 # (2026-11-27, with the thermal model carrying the estimate through the steps' holds): the stack
 # warmed by 19.3-19.6 K; true S on the steps 0.245-0.268 % with adaptation (the issue's goal:
 # 0.5 %; 0.691-0.784 % without the thermal model), 3.888-4.033 % without adaptation.
