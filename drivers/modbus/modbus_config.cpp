@@ -60,10 +60,11 @@ void read_registers(io::YamlMap& parent, RegisterMap& map) {
   auto r = parent.optional_map("registers");
   if (!r) return;
   map = RegisterMap{};
-  const std::array<std::pair<const char*, RegisterSpec*>, 6> entries{
+  const std::array<std::pair<const char*, RegisterSpec*>, 7> entries{
       std::pair{"e", &map.e},           std::pair{"d", &map.d},
       std::pair{"s_ref", &map.s_ref},   std::pair{"t_ref", &map.t_ref},
-      std::pair{"status", &map.status}, std::pair{"command", &map.command}};
+      std::pair{"status", &map.status}, std::pair{"command", &map.command},
+      std::pair{"temp", &map.temp}};
   for (const auto& [key, spec] : entries) {
     if (auto m = r->optional_map(key)) read_register(*m, *spec);
   }

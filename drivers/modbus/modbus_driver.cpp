@@ -284,6 +284,7 @@ bool ModbusDriver::poll_inputs(std::uint64_t seq) noexcept {
   value(m.d, s.in.d);
   value(m.s_ref, s.in.s_ref);
   value(m.t_ref, s.in.t_ref);
+  value(m.temp, s.in.temp_ref);
   if (m.status.enabled) {
     double status = 0.0;
     value(m.status, status);

@@ -122,9 +122,10 @@ std::string RegisterMap::problem() const {
     const char* key;
     const RegisterSpec* spec;
   };
-  const std::array<Named, 6> all{Named{"e", &e},           Named{"d", &d},
+  const std::array<Named, 7> all{Named{"e", &e},           Named{"d", &d},
                                  Named{"s_ref", &s_ref},   Named{"t_ref", &t_ref},
-                                 Named{"status", &status}, Named{"command", &command}};
+                                 Named{"status", &status}, Named{"command", &command},
+                                 Named{"temp", &temp}};
   for (const char* required : {"e", "d", "command"}) {
     for (const Named& n : all) {
       if (std::string_view(n.key) == required && !n.spec->enabled) {
@@ -178,6 +179,13 @@ RegisterMap default_register_map() {
   m.status.type = RegisterType::kUint16;
   m.command = input(0);
   m.command.function = Function::kHolding;
+  return m;
+}
+
+RegisterMap served_register_map() {
+  RegisterMap m = default_register_map();
+  m.temp = m.e;
+  m.temp.address = 9;
   return m;
 }
 

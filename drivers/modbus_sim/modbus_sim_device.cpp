@@ -1,13 +1,13 @@
 // The simulated transducer as a Modbus server (TCP or RTU) over libmodbus, with the default
-// register map of the Modbus driver (include/selfsense/drivers/modbus/register_map.hpp,
-// docs/drivers/modbus.md).
+// register map of the Modbus driver and the stack's temperature (served_register_map(),
+// include/selfsense/drivers/modbus/register_map.hpp, docs/drivers/modbus.md).
 //
 // One thread: ppoll() on the bus descriptors until the next update deadline (absolute, on
 // CLOCK_MONOTONIC). Each update writes the command register's value to the simulated amplifier
 // (zero-order hold, like a DAC), advances the plant by one device period, and stores the
-// measured E, D, the true S, T and the plant's status bits in the input registers. Requests are
-// answered between updates from the register tables; a register outside the map gets the
-// exception response "illegal data address". SIGINT and SIGTERM end it with status 0.
+// measured E, D, the true S, T, the plant's status bits and temperature in the input registers.
+// Requests are answered between updates from the register tables; a register outside the map gets
+// the exception response "illegal data address". SIGINT and SIGTERM end it with status 0.
 #include "selfsense/drivers/modbus_sim/modbus_sim_device.hpp"
 
 #include <modbus.h>
@@ -147,6 +147,7 @@ class Device final {
     store(map_.s_ref, in.s_ref);
     store(map_.t_ref, in.t_ref);
     store(map_.status, in.device_status);
+    store(map_.temp, in.temp_ref);
     ++updates_;
   }
 
@@ -241,7 +242,7 @@ std::int64_t run_due_updates(Device& device, std::int64_t next) {
 
 int serve_modbus_tcp(const ModbusSimDeviceOptions& options, const std::string& host, int port) {
   const StopSignals signals;
-  Device device(options, mb::default_register_map());
+  Device device(options, mb::served_register_map());
   set_priority(options.priority);
   const std::unique_ptr<modbus_t, ContextDeleter> ctx(
       modbus_new_tcp_pi(host.c_str(), std::to_string(port).c_str()));
@@ -306,7 +307,7 @@ int serve_modbus_tcp(const ModbusSimDeviceOptions& options, const std::string& h
 
 int serve_modbus_rtu(const ModbusSimDeviceOptions& options, const std::string& device_path) {
   const StopSignals signals;
-  Device device(options, mb::default_register_map());
+  Device device(options, mb::served_register_map());
   set_priority(options.priority);
   const std::unique_ptr<modbus_t, ContextDeleter> ctx(
       modbus_new_rtu(device_path.c_str(), options.baud, 'N', 8, 1));

@@ -81,6 +81,7 @@ AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& mode
       gate_(model.drive_range, model.sensed_range, range_margin),
       last_{0.0, kNaN, models::SampleStatus::kOk} {
   if (kernel_.actuator()) actuator_split_.emplace(*kernel_.actuator());
+  if (config.thermal.enabled) thermal_.emplace(config.thermal, model.sample_time);
   identity_ = {model.structure, models::parameter_hash(model), state_size()};
   if (!(range_margin >= 0.0)) {
     throw std::invalid_argument{"adaptation: range_margin must be >= 0"};
@@ -150,24 +151,35 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field,
     out.strain = fixed_a + (1.0 + dr.coupling) * pa.linear + (1.0 + dr.loop) * pa.loop +
                  (1.0 + dr.compliance) * a.coupling() * out.stress;
   }
+  if (thermal_) {  // carry the estimate to the next sample's predicted temperature
+    thermal_->step(field, sensed, accepted);
+    estimator_.carry(thermal_->predict(dr.temperature_degc) - dr.temperature_degc);
+  }
   return out;
 }
 
 std::size_t AdaptedReconstruction::state_size() const noexcept {
-  return kernel_.state_size() + DriftEstimator::state_size();
+  return kernel_.state_size() + DriftEstimator::state_size() +
+         (thermal_ ? ThermalModel::state_size() : 0U);
 }
 
 bool AdaptedReconstruction::save_state(std::span<double> out) const noexcept {
   if (out.size() != state_size()) return false;
   kernel_.save_state(out.first(kernel_.state_size()));
-  estimator_.save_state(out.subspan(kernel_.state_size()));
+  estimator_.save_state(out.subspan(kernel_.state_size(), DriftEstimator::state_size()));
+  if (thermal_) {
+    thermal_->save_state(out.subspan(kernel_.state_size() + DriftEstimator::state_size()));
+  }
   return true;
 }
 
 bool AdaptedReconstruction::restore_state(std::span<const double> in) noexcept {
   if (in.size() != state_size()) return false;
   kernel_.restore_state(in.first(kernel_.state_size()));
-  estimator_.restore_state(in.subspan(kernel_.state_size()));
+  estimator_.restore_state(in.subspan(kernel_.state_size(), DriftEstimator::state_size()));
+  if (thermal_) {
+    thermal_->restore_state(in.subspan(kernel_.state_size() + DriftEstimator::state_size()));
+  }
   return true;
 }
 

@@ -46,7 +46,7 @@ bool DriftEstimatorConfig::is_valid(const std::string& prefix, std::string* why)
   if (!(load_stiffness_ratio >= 0.0)) {
     return fail(why, prefix + "load_stiffness_ratio: must be >= 0");
   }
-  return true;
+  return !thermal.enabled || thermal.is_valid(prefix, why);
 }
 
 DriftEstimator::DriftEstimator(const DriftEstimatorConfig& config, double sample_time_s, double c0)
@@ -141,6 +141,13 @@ void DriftEstimator::set_temperature(double degc) noexcept {
   const double rise = degc - config_.reference_degc;
   theta_[0] = std::clamp(config_.permittivity_per_k * rise, -bound, bound);
   theta_[1] = std::clamp(config_.loop_per_k * rise, -bound, bound);
+}
+
+void DriftEstimator::carry(double delta_k) noexcept {
+  if (config_.frozen || !std::isfinite(delta_k)) return;
+  const double bound = config_.max_relative_change;
+  theta_[0] = std::clamp(theta_[0] + config_.permittivity_per_k * delta_k, -bound, bound);
+  theta_[1] = std::clamp(theta_[1] + config_.loop_per_k * delta_k, -bound, bound);
 }
 
 void DriftEstimator::save_state(std::span<double> out) const noexcept {

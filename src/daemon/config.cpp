@@ -201,6 +201,12 @@ void read_adaptation(YamlMap a, AdaptationSection& out) {
   a.read("coupling_per_k", e.coupling_per_k);
   a.read("compliance_per_k", e.compliance_per_k);
   a.read("load_stiffness_ratio", e.load_stiffness_ratio);
+  a.read("thermal_model", e.thermal.enabled);
+  a.read("thermal_resistance_k_per_w", e.thermal.resistance_k_per_w);
+  a.read("thermal_time_constant_s", e.thermal.time_constant_s);
+  a.read("ambient_degc", e.thermal.ambient_degc);
+  a.read("stack_volume_m3", e.thermal.stack_volume_m3);
+  a.read("max_power_w", e.thermal.max_power_w);
   a.finish();
 }
 

@@ -28,6 +28,7 @@ using Dm = control::DampingController::Params;
 using S = SafetySection;
 using A = AdaptationSection;
 using E = adaptation::DriftEstimatorConfig;
+using Th = adaptation::ThermalModelConfig;
 using H = HealthSection;
 using He = adaptation::HealthEstimatorConfig;
 using Hb = adaptation::HealthBands;
@@ -149,6 +150,18 @@ const std::array kTable{
               differs<&C::adaptation, &A::estimator, &E::compliance_per_k>},
     ReloadKey{"adaptation.load_stiffness_ratio", kRefused,
               differs<&C::adaptation, &A::estimator, &E::load_stiffness_ratio>},
+    ReloadKey{"adaptation.thermal_model", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::thermal, &Th::enabled>},
+    ReloadKey{"adaptation.thermal_resistance_k_per_w", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::thermal, &Th::resistance_k_per_w>},
+    ReloadKey{"adaptation.thermal_time_constant_s", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::thermal, &Th::time_constant_s>},
+    ReloadKey{"adaptation.ambient_degc", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::thermal, &Th::ambient_degc>},
+    ReloadKey{"adaptation.stack_volume_m3", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::thermal, &Th::stack_volume_m3>},
+    ReloadKey{"adaptation.max_power_w", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::thermal, &Th::max_power_w>},
     // The health estimate's baseline and trends are learned with these (a restart starts anew).
     ReloadKey{"health.enabled", kRefused, differs<&C::health, &H::enabled>},
     ReloadKey{"health.fault", kRefused, differs<&C::health, &H::bands, &Hb::fault>},

@@ -144,6 +144,19 @@ TEST(DaemonConfig, TheAdaptationSectionIsReadStrictlyAndValidated) {
       load_sim("adapt-mount", {{"load_stiffness_ratio: 0.21", "load_stiffness_ratio: -0.2"}});
   EXPECT_TRUE(has(mount, "adaptation.load_stiffness_ratio: must be >= 0"))
       << mount.problems.front();
+  // The thermal model's keys: read, and validated once it is on.
+  const ConfigResult thermal = load_sim(
+      "adapt-thermal", {{"thermal_model: false", "thermal_model: true"},
+                        {"thermal_time_constant_s: 600.0", "thermal_time_constant_s: 20.0"}});
+  ASSERT_TRUE(thermal.ok()) << thermal.problems.front();
+  EXPECT_TRUE(thermal.config.adaptation.estimator.thermal.enabled);
+  EXPECT_EQ(thermal.config.adaptation.estimator.thermal.time_constant_s, 20.0);
+  EXPECT_EQ(thermal.config.adaptation.estimator.thermal.resistance_k_per_w, 50.0);
+  const ConfigResult thermal_bad = load_sim(
+      "adapt-thermal-bad", {{"thermal_model: false", "thermal_model: true"},
+                            {"thermal_time_constant_s: 600.0", "thermal_time_constant_s: 0"}});
+  EXPECT_TRUE(has(thermal_bad, "adaptation.thermal_time_constant_s: must be > 0"))
+      << thermal_bad.problems.front();
   const ConfigResult unknown = load_sim("adapt-unknown", {{"  compliance_per_k: 5.0e-4",
                                                            "  compliance_per_k: 5.0e-4\n"
                                                            "  forget: 3"}});

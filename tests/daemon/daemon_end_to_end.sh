@@ -54,22 +54,22 @@ awk -v v="$damped" 'BEGIN { exit !(v > 0) }' || fail "no damped ring-down: '$dam
 echo "ok: ring-down of true S ${undamped} ms > 120 ms undamped, ${damped} ms > 0 damped"
 
 # The self-heating run (config/heating-sim.yaml: a 200 Hz sine in open loop warms the stack,
-# then position steps; docs/daemon.md, "Self-heating in the main job"). Measured in three runs
-# (2026-11-27, with the mount's prediction following the drift): the stack warmed by
-# 19.3-19.4 K; true S on the steps 0.724-0.784 % with adaptation (the issue's goal of 0.5 % is
-# not met: the estimate holds while the stack cools during the steps), 3.942-4.020 % without.
+# then position steps; docs/daemon.md, "Self-heating in the main job"). Measured in six runs
+# (2026-11-27, with the thermal model carrying the estimate through the steps' holds): the stack
+# warmed by 19.3-19.6 K; true S on the steps 0.245-0.268 % with adaptation (the issue's goal:
+# 0.5 %; 0.691-0.784 % without the thermal model), 3.888-4.033 % without adaptation.
 # Asserted: the warming at least the issue's 15 K, the adapted figure under 1.3x the largest
-# seen (1.02 %), the unadapted one above the smallest / 1.3 (3.03 %: the warming is there to be
+# seen (0.35 %), the unadapted one above the smallest / 1.3 (2.99 %: the warming is there to be
 # corrected).
-check heating-adapted S 1.02
+check heating-adapted S 0.35
 rise=$(sed -n 's/^self-heating: the sine warmed the stack by \([0-9.]*\) K.*/\1/p' "$out/figures.txt")
 [ -n "$rise" ] || fail "no self-heating figure in: $(cat "$out/figures.txt")"
 awk -v v="$rise" 'BEGIN { exit !(v >= 15) }' || fail "the sine warmed the stack by only $rise K"
 plain=$(sed -n 's/^heating-plain: .* true S \([0-9.]*\) % RMS.*/\1/p' "$out/figures.txt")
-awk -v v="$plain" 'BEGIN { exit !(v > 3.03) }' || fail "without adaptation true S is only '$plain' %"
+awk -v v="$plain" 'BEGIN { exit !(v > 2.99) }' || fail "without adaptation true S is only '$plain' %"
 grep -q '^heating-adapted: .* equivalent 25.0 -> [0-9]' "$out/figures.txt" ||
   fail "no equivalent temperature in the adapted run: $(grep '^heating-adapted' "$out/figures.txt")"
-echo "ok: self-heating by $rise K >= 15 K; true S without adaptation $plain % > 3.03 %"
+echo "ok: self-heating by $rise K >= 15 K; true S without adaptation $plain % > 2.99 %"
 grep -q 'plant (true)' "$out/main_job.html" && grep -q 'equivalent (adaptation)' "$out/main_job.html" ||
   fail "the page has no temperature plot"
 

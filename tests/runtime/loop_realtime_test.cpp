@@ -36,8 +36,10 @@ class CountingSink final : public SampleSink {
 };
 
 void every_mode_without_allocating(const models::TransducerModel& model, bool adapt = false,
-                                   bool health = false) {
+                                   bool health = false, bool thermal = false) {
   constexpr double kTs = 1e-4;
+  adaptation::DriftEstimatorConfig adapt_config{};
+  adapt_config.thermal.enabled = thermal;  // the thermal model carries the estimate (on holds)
   plant::PlantConfig pc;
   pc.sample_rate_hz = 1e4;
   pc.hysteresis.enabled = true;
@@ -70,10 +72,10 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
   }
   CountingSink sink;
   std::unique_ptr<Loop> loop_owner =
-      adapt ? std::make_unique<Loop>(lc, driver,
-                                     std::make_unique<adaptation::AdaptedReconstruction>(
-                                         model, adaptation::DriftEstimatorConfig{}, kTs),
-                                     Controller(cc, model.actuator, kTs), &sink)
+      adapt ? std::make_unique<Loop>(
+                  lc, driver,
+                  std::make_unique<adaptation::AdaptedReconstruction>(model, adapt_config, kTs),
+                  Controller(cc, model.actuator, kTs), &sink)
             : std::make_unique<Loop>(
                   lc, driver,
                   std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{kTs}),
@@ -99,8 +101,7 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
   tuned.command_max = 1.8e6;
   // A state dump's buffer, sized for the running reconstruction.
   models::SavedState state =
-      adapt ? adaptation::AdaptedReconstruction(model, adaptation::DriftEstimatorConfig{}, kTs)
-                  .make_saved_state()
+      adapt ? adaptation::AdaptedReconstruction(model, adapt_config, kTs).make_saved_state()
             : next_model->make_saved_state();
   // And the health state's, saved with it when health runs.
   std::vector<double> health_state(loop.health_state_size(), 0.0);
@@ -222,6 +223,10 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithAdaptationAndTheShippedPrei
   every_mode_without_allocating(
       models::load_model(std::filesystem::path(SELFSENSE_SOURCE_DIR) / "config/models/sim.yaml"),
       true);
+}
+
+TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithAdaptationAndTheThermalModel) {
+  every_mode_without_allocating(test::typical_transducer(1e-3), true, false, true);
 }
 
 TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithHealth) {

@@ -28,6 +28,14 @@
 // error comes from".) r = 0: the stress is taken as independent of the field
 // (docs/adaptation.md).
 //
+// With the thermal model on (config.thermal.enabled, thermal_model.hpp), after each sample the
+// estimate is carried to the temperature the thermal law predicts for the next one, from the
+// power of the measured E and D (a rejected sample brings none) and the present equivalent
+// temperature theta:
+//   estimator.carry(theta[k+1] - theta[k]),  theta[k+1] = thermal law (thermal_model.hpp)
+// so the estimate cools with the stack on holds, where the estimator cannot learn; frozen, it
+// holds. Its state (4 values) follows the estimator's in the saved state, and only then.
+//
 // A sample whose inputs are not finite or outside the identification range (widened by
 // range_margin of its span) is rejected as models::Reconstruction rejects it: the operators
 // advance with the last accepted inputs, the estimator learns nothing and drops its anchor.
@@ -41,6 +49,7 @@
 #include <span>
 
 #include "selfsense/adaptation/drift_estimator.hpp"
+#include "selfsense/adaptation/thermal_model.hpp"
 #include "selfsense/models/model_identity.hpp"
 #include "selfsense/models/reconstructor.hpp"
 #include "selfsense/models/runtime_model.hpp"
@@ -109,7 +118,10 @@ class AdaptedReconstruction final {
   [[nodiscard]] const models::StatusCounts& counts() const noexcept { return counts_; }
   [[nodiscard]] bool has_strain() const noexcept { return kernel_.actuator().has_value(); }
 
-  // The kernel's operator state followed by the estimator's.
+  // The thermal model, when it is on.
+  [[nodiscard]] const std::optional<ThermalModel>& thermal() const noexcept { return thermal_; }
+
+  // The kernel's operator state followed by the estimator's (and the thermal model's, when on).
   [[nodiscard]] std::size_t state_size() const noexcept;
   // False (nothing written or read) if the span's size is not state_size().
   bool save_state(std::span<double> out) const noexcept;
@@ -132,6 +144,7 @@ class AdaptedReconstruction final {
   SideSplit sensor_split_;
   std::optional<SideSplit> actuator_split_{};
   DriftEstimator estimator_;
+  std::optional<ThermalModel> thermal_{};
   models::detail::InputGate gate_{};
   models::detail::HeldInputs held_{};
   Estimate last_{};

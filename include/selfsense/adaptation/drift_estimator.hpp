@@ -32,6 +32,10 @@
 // parameter. phi and z are divided by c0 min_field_step_v_per_m (a smallest update's capacitive
 // increment, c0 the model's linear weight), so they are dimensionless and about 1.
 //
+// Between updates the estimate can be carried along a predicted temperature change (carry():
+// the thermal model of thermal_model.hpp, a known input of the drift's process model):
+//   epsilon += permittivity_per_k delta_theta,   lambda += loop_per_k delta_theta
+//
 // Equivalent temperature: theta_eq = reference_degc + epsilon / permittivity_per_k [degC]; the
 // coupling and compliance follow it: d' = (1 + coupling_per_k (theta_eq - reference)) d.
 //
@@ -43,6 +47,8 @@
 #include <cstddef>
 #include <span>
 #include <string>
+
+#include "selfsense/adaptation/thermal_model.hpp"
 
 namespace selfsense::adaptation {
 
@@ -66,9 +72,13 @@ struct DriftEstimatorConfig {
   // The mount (adapted_reconstruction.hpp): the load's stiffness over the stack's,
   // r = k_load / k_stack [1]; 0: a free actuator, or a load that does not follow the field.
   double load_stiffness_ratio{0.0};
+  // The thermal model that carries the estimate between updates (thermal_model.hpp;
+  // adapted_reconstruction.hpp runs it). Off by default: the estimate holds between updates.
+  ThermalModelConfig thermal{};
 
   // Every value finite; steps, intervals, memory > 1, variance, bound positive;
-  // permittivity_per_k non-zero; load_stiffness_ratio >= 0. *why names the key under `prefix`
+  // permittivity_per_k non-zero; load_stiffness_ratio >= 0; the thermal model's keys
+  // (thermal_model.hpp) when it is enabled. *why names the key under `prefix`
   // ("adaptation.memory_updates: must be > 1").
   [[nodiscard]] bool is_valid(const std::string& prefix, std::string* why) const;
   friend bool operator==(const DriftEstimatorConfig&, const DriftEstimatorConfig&) = default;
@@ -105,6 +115,10 @@ class DriftEstimator final {
   // Sets the drift from a measured temperature instead of learning it (a temperature sensor):
   // epsilon = permittivity_per_k dT, lambda = loop_per_k dT.
   void set_temperature(double degc) noexcept;
+  // Moves the estimate along a predicted temperature change (thermal_model.hpp) without
+  // learning: epsilon += permittivity_per_k delta, lambda += loop_per_k delta [delta in K],
+  // clamped to +-max_relative_change. Ignored when frozen or not finite.
+  void carry(double delta_k) noexcept;
   [[nodiscard]] const DriftEstimatorConfig& config() const noexcept { return config_; }
 
   [[nodiscard]] static constexpr std::size_t state_size() noexcept { return kStateSize; }

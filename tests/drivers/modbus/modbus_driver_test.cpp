@@ -250,6 +250,46 @@ TEST(ModbusDriver, ValuesOutsideTheirRangeAreBadDataNotOk) {
   EXPECT_GT(d->counters().bad_data, 50U);
 }
 
+// The stack's temperature through a register (`registers.temp`): the sim-device serves its
+// plant's temperature in input registers 9-10; the driver reads it only when configured, and
+// then says so (has_temperature(), the recording's `temp` column). A plant without a
+// temperature model serves a quiet NaN, which is bad data for a driver that asks for it.
+TEST(ModbusDriver, TheTemperatureRegisterIsReadWhenConfigured) {
+  {
+    test::SimDeviceProcess device(
+        SELFSENSE_CLI, std::string(SELFSENSE_SOURCE_DIR) + "/config/plant/daemon-heating.yaml",
+        1000.0, {"--modbus-tcp", "127.0.0.1:0"});
+    ModbusConfig plain_config = tcp_config(device.port());
+    auto plain = start(plain_config);
+    EXPECT_FALSE(plain->has_temperature());
+    const Tally p = run_for(*plain, 300ms, 1.0e6);
+    EXPECT_GT(p.count(DriverStatus::kOk), 50);
+    EXPECT_TRUE(std::isnan(p.last_ok.temp_ref));
+    plain->deactivate();
+
+    ModbusConfig c = tcp_config(device.port());
+    c.registers.temp = served_register_map().temp;
+    ASSERT_EQ(c.registers.temp.address, 9);
+    auto d = start(c);
+    EXPECT_TRUE(d->has_temperature());
+    const Tally t = run_for(*d, 600ms, 1.0e6);
+    EXPECT_GT(t.count(DriverStatus::kOk), 100);
+    // The heating bench starts at 25 degC and warms by well under a kelvin in a second.
+    EXPECT_NEAR(t.last_ok.temp_ref, 25.0, 1.0);
+    EXPECT_EQ(d->counters().bad_data, 0U);
+    d->deactivate();
+    EXPECT_EQ(device.stop(SIGTERM), 0);
+  }
+  SimDevice device({"--modbus-tcp", "127.0.0.1:0"});  // config/plant/daemon.yaml: no temperature
+  ModbusConfig c = tcp_config(device.port());
+  c.registers.temp = served_register_map().temp;
+  auto d = start(c);
+  static_cast<void>(run_for(*d, 200ms, 1.0e6));
+  const Tally t = run_for(*d, 300ms, 1.0e6);
+  EXPECT_EQ(t.count(DriverStatus::kOk), 0);
+  EXPECT_GT(t.count(DriverStatus::kBadData), 50);
+}
+
 // A TCP server that answers every request with random bytes.
 class GarbageServer final {
  public:

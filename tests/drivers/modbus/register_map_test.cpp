@@ -144,6 +144,14 @@ TEST(RegisterMap, DefaultMapIsValidAndProblemsNameTheEntry) {
   m = default_register_map();
   m.e.scale = 0.0;
   EXPECT_EQ(m.problem(), "registers.e.scale: must be finite and non-zero");
+  // The sim-device's map: the default one and the temperature after the status register.
+  m = served_register_map();
+  EXPECT_EQ(m.problem(), "");
+  EXPECT_FALSE(default_register_map().temp.enabled);
+  EXPECT_TRUE(m.temp.enabled);
+  m.temp.address = 8;
+  EXPECT_EQ(m.problem(),
+            "registers.temp.address: 8 overlaps registers.status in the input registers");
 }
 
 std::vector<std::string> read_section(const std::string& yaml, Transport t,
@@ -169,9 +177,12 @@ TEST(ModbusConfig, ReadsTcpAndRtuSectionsWithTheirOwnKeys) {
                            "  registers:\n    e: {address: 10, type: int32, word_order: low-first, "
                            "scale: 0.5}\n    d: {address: 12, type: int16}\n"
                            "    command: {address: 3, function: holding, type: uint16, "
-                           "offset: -5}\n",
+                           "offset: -5}\n    temp: {address: 20, type: int16, scale: 0.1}\n",
                            Transport::kTcp, &c)
                   .empty());
+  EXPECT_TRUE(c.registers.temp.enabled);  // the stack's temperature: 0.1 degC per count
+  EXPECT_EQ(c.registers.temp.address, 20);
+  EXPECT_DOUBLE_EQ(c.registers.temp.scale, 0.1);
   EXPECT_EQ(c.host, "plc");
   EXPECT_EQ(c.port, 1502);
   EXPECT_EQ(c.registers.e.type, RegisterType::kInt32);
@@ -184,6 +195,7 @@ TEST(ModbusConfig, ReadsTcpAndRtuSectionsWithTheirOwnKeys) {
                   .empty());
   EXPECT_EQ(c.parity, 'E');
   EXPECT_TRUE(c.registers.s_ref.enabled) << "no registers: the default map";
+  EXPECT_FALSE(c.registers.temp.enabled) << "the default map has no temperature";
 }
 
 TEST(ModbusConfig, EveryProblemNamesItsKeyAndLine) {

@@ -12,7 +12,8 @@
 //   max_age_s: 0               the held sample older than this: kStale; 0: 2.5 poll periods
 //   sample_timeout_s: 0.02     a sample older than this: kTimeout
 //   reconnect: {min_s: 0.01, max_s: 1.0, after_failures: 3}
-//   registers: {e: {...}, d: {...}, s_ref, t_ref, status, command}  (absent: the default map)
+//   registers: {e: {...}, d: {...}, s_ref, t_ref, status, command, temp}  (absent: the default
+//              map; temp: the stack's temperature [degC], the driver's has_temperature())
 //     each: {address: N, function: input|holding, type: int16|uint16|int32|float32,
 //            word_order: high-first|low-first, scale: 1, offset: 0, range: [min, max]}
 // Not real-time code.

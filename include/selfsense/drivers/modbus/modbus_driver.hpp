@@ -97,6 +97,10 @@ class ModbusDriver final : public runtime::Driver {
   [[nodiscard]] bool has_references() const noexcept override {
     return config_.registers.s_ref.enabled || config_.registers.t_ref.enabled;
   }
+  // With `registers.temp`: read() fills temp_ref [degC] (the recording's `temp` column).
+  [[nodiscard]] bool has_temperature() const noexcept override {
+    return config_.registers.temp.enabled;
+  }
   [[nodiscard]] runtime::DriverCounters counters() const noexcept override;
 
   [[nodiscard]] bool connected() const noexcept {

@@ -67,7 +67,9 @@ struct Decoded {
                           std::span<std::uint16_t> words) noexcept;
 
 // The transducer's registers. e and d are required; s_ref and t_ref optional (both or none);
-// status (uint16, into InputSample::device_status) optional; command is required.
+// status (uint16, into InputSample::device_status) optional; temp (the stack's temperature
+// [degC], into InputSample::temp_ref: the recording's `temp` column and the driver's
+// has_temperature()) optional; command is required.
 struct RegisterMap {
   RegisterSpec e{};
   RegisterSpec d{};
@@ -75,10 +77,11 @@ struct RegisterMap {
   RegisterSpec t_ref{};
   RegisterSpec status{};
   RegisterSpec command{};
+  RegisterSpec temp{};
 
-  // The inputs in a fixed order (e, d, s_ref, t_ref, status), for iteration.
-  [[nodiscard]] std::array<const RegisterSpec*, 5> inputs() const noexcept {
-    return {&e, &d, &s_ref, &t_ref, &status};
+  // The inputs in a fixed order (e, d, s_ref, t_ref, status, temp), for iteration.
+  [[nodiscard]] std::array<const RegisterSpec*, 6> inputs() const noexcept {
+    return {&e, &d, &s_ref, &t_ref, &status, &temp};
   }
   // Empty when valid, else "registers.KEY.FIELD: what" (required entries present, the command a
   // holding register, no two entries overlapping in the same table, every spec valid).
@@ -88,7 +91,12 @@ struct RegisterMap {
 // The map `selfsense sim-device` serves unless told otherwise (docs/drivers/modbus.md):
 // input registers, float32 high word first, scale 1:
 //   0-1 E [V/m], 2-3 D [C/m^2], 4-5 S [-], 6-7 T [Pa], 8 status (uint16)
-// holding registers: 0-1 command E [V/m] (float32 high word first)
+// holding registers: 0-1 command E [V/m] (float32 high word first). No temperature.
 [[nodiscard]] RegisterMap default_register_map();
+
+// The map `selfsense sim-device` serves: the default map and the stack's temperature in input
+// registers 9-10 [degC] (float32 high word first; a quiet NaN when the plant has no temperature
+// model), which a driver reads only when its `registers` name `temp`.
+[[nodiscard]] RegisterMap served_register_map();
 
 }  // namespace selfsense::drivers::modbus
