@@ -2,11 +2,15 @@
 # Builds, as root, the Debian 12 VM image the VM tests boot under qemu: a debootstrap minbase
 # root with Debian's kernel, systemd as PID 1, CAN tools and the project's runtime libraries
 # (packages.txt), set up to boot fast on a serial console and to run the payload disk
-# (guest/selfsense-payload.service). Cached under /var/cache/selfsense-vm/KEY/ (KEY hashes
-# this script, packages.txt and guest/), so a second call returns at once.
+# (guest/selfsense-payload.service). Cached under /var/cache/selfsense-vm/ARCH/KEY/ (KEY hashes
+# the architecture, this script, packages.txt and guest/), so a second call returns at once.
 #
 #   scripts/vm/image.sh           build unless cached; prints the image directory on stdout
 #   scripts/vm/image.sh --check   prints the directory and exits 0 if cached, exits 1 if not
+#
+# SELFSENSE_VM_ARCH=arm64 builds the arm64 image (booted by qemu-system-aarch64): the same root,
+# made by debootstrap --arch=arm64 whose second stage and apt-get run under qemu-user
+# (qemu-user-static through binfmt_misc).
 #
 # The directory holds root.img (ext4, label root), vmlinuz and initrd.img.
 set -euo pipefail
@@ -35,8 +39,14 @@ step() { vm_say "image: $* (+$((SECONDS - start)) s)"; }
 
 install_host_tools() {
   local missing=() tool package
-  for tool in debootstrap:debootstrap qemu-system-x86_64:qemu-system-x86 mke2fs:e2fsprogs \
-    debugfs:e2fsprogs; do
+  local tools=(debootstrap:debootstrap mke2fs:e2fsprogs debugfs:e2fsprogs)
+  if [ "$vm_arch" = arm64 ]; then
+    tools+=(qemu-system-aarch64:qemu-system-arm qemu-aarch64-static:qemu-user-static
+      update-binfmts:binfmt-support)
+  else
+    tools+=(qemu-system-x86_64:qemu-system-x86)
+  fi
+  for tool in "${tools[@]}"; do
     package=${tool#*:}
     command -v "${tool%%:*}" >/dev/null || missing+=("$package")
   done
@@ -63,8 +73,18 @@ security=$(host_uris | grep -E '/debian-security/?$' | head -1 || true)
 mirror=${mirror:-http://deb.debian.org/debian}
 security=${security:-http://deb.debian.org/debian-security}
 
+# The arm64 root's programs run here under qemu-user: the kernel must hand aarch64 ELF files to
+# qemu-aarch64-static (binfmt_misc, registered by qemu-user-static's postinst).
+enable_binfmt() {
+  [ "$vm_arch" = arm64 ] || return 0
+  [ -f /proc/sys/fs/binfmt_misc/status ] || mount -t binfmt_misc binfmt_misc /proc/sys/fs/binfmt_misc
+  [ -f /proc/sys/fs/binfmt_misc/qemu-aarch64 ] || update-binfmts --enable qemu-aarch64 >&2 ||
+    vm_die "no binfmt_misc entry for aarch64 (update-binfmts --enable qemu-aarch64)"
+}
+
 install_host_tools
-mkdir -p "$vm_cache_root"
+enable_binfmt
+mkdir -p "$vm_cache_root/$vm_arch"
 # One build at a time; a second caller waits and then finds the image cached.
 exec 9>"$vm_cache_root/.lock"
 flock 9
@@ -97,8 +117,8 @@ mkdir -p "$root"
 # the root is kept but the ext4 image made from it.
 mount -t tmpfs -o size=4g,mode=0755 selfsense-vm-root "$root"
 
-step "debootstrap --variant=minbase $suite from $mirror"
-debootstrap --variant=minbase "$suite" "$root" "$mirror" >"$build/debootstrap.log" 2>&1 ||
+step "debootstrap --arch=$vm_arch --variant=minbase $suite from $mirror"
+debootstrap --arch="$vm_arch" --variant=minbase "$suite" "$root" "$mirror" >"$build/debootstrap.log" 2>&1 ||
   { tail -20 "$build/debootstrap.log" >&2; vm_die "debootstrap failed (log: $build/debootstrap.log)"; }
 
 cat >"$root/etc/apt/sources.list" <<EOF
@@ -121,7 +141,7 @@ chmod +x "$root/usr/sbin/policy-rc.d"
 # Debian's default of most modules.
 mkdir -p "$root/etc/initramfs-tools/conf.d"
 printf 'MODULES=list\nCOMPRESS=gzip\n' >"$root/etc/initramfs-tools/conf.d/selfsense"
-printf 'virtio_pci\nvirtio_blk\next4\ncrc32c_generic\n' >"$root/etc/initramfs-tools/modules"
+printf 'virtio_pci\nvirtio_mmio\nvirtio_blk\next4\ncrc32c_generic\n' >"$root/etc/initramfs-tools/modules"
 
 mount -t proc proc "$root/proc"
 mount -t sysfs sys "$root/sys"
@@ -154,8 +174,8 @@ chroot "$root" passwd -d root >/dev/null
 mkdir -p "$root/etc/systemd/journald.conf.d"
 install -m 0644 "$vm_scripts/guest/journald.conf" "$root/etc/systemd/journald.conf.d/selfsense.conf"
 install -m 0755 "$vm_scripts/guest/selfsense-payload" "$root/usr/local/sbin/selfsense-payload"
-install -m 0644 "$vm_scripts/guest/selfsense-payload.service" \
-  "$root/etc/systemd/system/selfsense-payload.service"
+sed "s|/dev/ttyS0|/dev/$(vm_console)|" "$vm_scripts/guest/selfsense-payload.service" \
+  >"$root/etc/systemd/system/selfsense-payload.service"
 chroot "$root" systemctl enable selfsense-payload.service >/dev/null 2>&1
 # Nothing else may write to the serial console or hold up the boot: no login prompts (a getty
 # hangs up the tty the payload writes to), no timers, no waiting for a network, and none of the
@@ -165,7 +185,7 @@ timers=()
 for timer in "$root"/lib/systemd/system/*.timer; do
   [[ $timer == *@* ]] || timers+=("$(basename "$timer")")
 done
-chroot "$root" systemctl mask getty@tty1.service serial-getty@ttyS0.service getty.target \
+chroot "$root" systemctl mask getty@tty1.service "serial-getty@$(vm_console).service" getty.target \
   systemd-firstboot.service systemd-networkd-wait-online.service e2scrub_reap.service \
   modprobe@configfs.service modprobe@dm_mod.service modprobe@drm.service \
   modprobe@efi_pstore.service modprobe@fuse.service modprobe@loop.service \
@@ -187,7 +207,7 @@ touch "$build/ready"
 
 rm -rf "$dir"
 mv "$build" "$dir"
-# Images of older keys are never used again.
-find "$vm_cache_root" -mindepth 1 -maxdepth 1 -type d ! -path "$dir" -exec rm -rf --one-file-system {} +
+# Images of older keys (of this architecture) are never used again.
+find "$vm_cache_root/$vm_arch" -mindepth 1 -maxdepth 1 -type d ! -path "$dir" -exec rm -rf --one-file-system {} +
 step "done: $dir ($(du -sh "$dir/root.img" | cut -f1) image, $((SECONDS - start)) s)"
 echo "$dir"

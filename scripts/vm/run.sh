@@ -10,6 +10,8 @@
 # (default: a fresh file under /tmp, named at the end). When $SELFSENSE_VM_OUT is set, what the
 # payload left under /payload/out is copied back to $SELFSENSE_VM_OUT/out.
 #
+# SELFSENSE_VM_ARCH=arm64 boots the arm64 image under qemu-system-aarch64 (the virt board).
+#
 # Exit status: the payload's; 124 when the VM ran out of time (TIMEOUT_S, default 300);
 # 125 when it stopped without reporting one (kernel panic, boot failure); 77 when the image
 # has not been built.
@@ -26,7 +28,15 @@ if ! image=$("$vm_scripts/image.sh" --check); then
   vm_say "no cached VM image for key $(vm_key) under $vm_cache_root; build it: scripts/vm/image.sh"
   exit 77
 fi
-command -v qemu-system-x86_64 >/dev/null || vm_die "qemu-system-x86_64 missing; run scripts/vm/image.sh (as root)"
+# -cpu max lets host-built programs use the instructions the host has. The arm64 guest is the
+# virt board (no firmware needed with -kernel) with a Cortex-A72, as on a Raspberry Pi 4/CM4:
+# the arm64 programs are built for plain armv8-a, and qemu emulates it faster than -cpu max.
+if [ "$vm_arch" = arm64 ]; then
+  qemu=(qemu-system-aarch64 -M virt -cpu cortex-a72)
+else
+  qemu=(qemu-system-x86_64 -cpu max)
+fi
+command -v "${qemu[0]}" >/dev/null || vm_die "${qemu[0]} missing; run scripts/vm/image.sh (as root)"
 
 work=$(mktemp -d /tmp/selfsense-vm.XXXXXX)
 log=${SELFSENSE_VM_LOG:-$work/console.log}
@@ -44,17 +54,16 @@ mke2fs -q -t ext4 -L payload -d "$payload" "$work/payload.img" "${size_mib}M" >/
 
 # quiet and loglevel=3 keep the console to the payload's lines and real errors; panic=-1 with
 # -no-reboot turns a kernel panic into qemu exiting at once instead of a hang.
-append="root=/dev/vda rw console=ttyS0 quiet loglevel=3 panic=-1 systemd.show_status=false"
+append="root=/dev/vda rw console=$(vm_console) quiet loglevel=3 panic=-1 systemd.show_status=false"
 append+=" ${SELFSENSE_VM_APPEND:-}"
 
 vm_say "run: booting $image with payload $payload (timeout ${timeout_s} s)"
 start=$SECONDS
 status=0
-# snapshot=on keeps the cached root unchanged (writes go to a temporary file); -cpu max lets
-# host-built programs use the instructions the host has. -nodefaults: no network, VGA,
-# floppy or CD-ROM to probe; the payload brings everything it needs.
-timeout --kill-after=10 "$timeout_s" qemu-system-x86_64 \
-  -m 1024 -smp 2 -cpu max -nographic -no-reboot -nodefaults -serial stdio \
+# snapshot=on keeps the cached root unchanged (writes go to a temporary file). -nodefaults: no
+# network, VGA, floppy or CD-ROM to probe; the payload brings everything it needs.
+timeout --kill-after=10 "$timeout_s" "${qemu[@]}" \
+  -m 1024 -smp 2 -nographic -no-reboot -nodefaults -serial stdio \
   -kernel "$image/vmlinuz" -initrd "$image/initrd.img" -append "$append" \
   -drive "file=$image/root.img,format=raw,if=virtio,snapshot=on" \
   -drive "file=$work/payload.img,format=raw,if=virtio" \

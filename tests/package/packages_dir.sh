@@ -7,7 +7,9 @@ set -euo pipefail
 
 build=$(cd "$1" && pwd)
 out=$2
-arch=$(dpkg --print-architecture)
+# A cross build names its architecture (cmake/SelfsensePackage.cmake); natively, dpkg's own.
+arch=$(sed -n 's/^set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE "\(.*\)")$/\1/p' "$build/CPackConfig.cmake")
+arch=${arch:-$(dpkg --print-architecture)}
 version=$(sed -n 's/^set(CPACK_PACKAGE_VERSION "\(.*\)")$/\1/p' "$build/CPackConfig.cmake")
 [ -n "$version" ] || { echo "packages_dir: no CPACK_PACKAGE_VERSION in $build/CPackConfig.cmake" >&2; exit 1; }
 name=selfsense_${version}_${arch}.deb

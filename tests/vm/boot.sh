@@ -5,8 +5,9 @@
 # others. The PROGRAMs (host-built, e.g. the selfsense tool) go in with their libraries;
 # --packages BUILD_DIR: the build's selfsense package (tests/package/packages_dir.sh) as
 # /payload/files/packages/, and the same as a lower version in /payload/files/packages/previous/
-# (the upgrade's starting point).
-#   tests/vm/boot.sh OUT_DIR [PROGRAM... | --file PATH... | --packages BUILD_DIR]
+# (the upgrade's starting point), unless --no-previous. --only NAME (repeated): only those
+# tests/vm/payload/NAME.sh. SELFSENSE_VM_ARCH (amd64 or arm64) chooses the VM (scripts/vm/).
+#   tests/vm/boot.sh OUT_DIR [PROGRAM... | --file PATH... | --packages BUILD_DIR | --no-previous | --only NAME...]
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
@@ -17,7 +18,7 @@ vm_previous_package() {
   local built=$1 dir=$2 deb version previous
   rm -rf "$dir" "$dir.tree"
   mkdir -p "$dir"
-  deb=$(ls "$built"/selfsense_*_"$(dpkg --print-architecture)".deb) || return 1
+  deb=$(ls "$built"/selfsense_*_"$vm_arch".deb) || return 1
   cp "$deb" "$dir/"
   version=$(dpkg-deb -f "$deb" Version)
   previous="$version~prev"
@@ -25,7 +26,7 @@ vm_previous_package() {
   dpkg-deb -R "$deb" "$dir.tree"
   sed -i "s/^Version: .*/Version: $previous/" "$dir.tree/DEBIAN/control"
   mkdir -p "$dir/previous"
-  dpkg-deb --root-owner-group -b "$dir.tree" "$dir/previous/selfsense_${previous}_$(dpkg --print-architecture).deb" >/dev/null
+  dpkg-deb --root-owner-group -b "$dir.tree" "$dir/previous/selfsense_${previous}_$vm_arch.deb" >/dev/null
   rm -rf "$dir.tree"
 }
 
@@ -34,23 +35,42 @@ out=$1
 shift
 vm_require_image
 args=(--timeout 540)
+packages=
+previous=yes
+tests=()
 while [ $# -gt 0 ]; do
   if [ "$1" = --file ]; then
     args+=(--file "${2:?--file needs a path}")
     shift 2
   elif [ "$1" = --packages ]; then
-    built=$(bash "$vm_repo/tests/package/packages_dir.sh" "${2:?--packages needs a build directory}" \
-      "$out-cpack") || { echo "FAIL: no packages to install in the VM"; exit 1; }
-    vm_previous_package "$built" "$out-vm/packages" || { echo "FAIL: no previous package for the upgrade"; exit 1; }
-    args+=(--file "$out-vm/packages")
+    packages=${2:?--packages needs a build directory}
+    shift 2
+  elif [ "$1" = --no-previous ]; then
+    previous=no
+    shift
+  elif [ "$1" = --only ]; then
+    tests+=("$vm_repo/tests/vm/payload/${2:?--only needs a test name}.sh")
     shift 2
   else
     args+=(--program "$1")
     shift
   fi
 done
+if [ -n "$packages" ]; then
+  built=$(bash "$vm_repo/tests/package/packages_dir.sh" "$packages" "$out-cpack") ||
+    { echo "FAIL: no packages to install in the VM"; exit 1; }
+  if [ "$previous" = yes ]; then
+    vm_previous_package "$built" "$out-vm/packages" || { echo "FAIL: no previous package for the upgrade"; exit 1; }
+  else
+    rm -rf "$out-vm/packages"
+    mkdir -p "$out-vm/packages"
+    cp "$built"/selfsense_*_"$vm_arch".deb "$out-vm/packages/" || { echo "FAIL: no $vm_arch package"; exit 1; }
+  fi
+  args+=(--file "$out-vm/packages")
+fi
+[ ${#tests[@]} -gt 0 ] || tests=("$vm_repo"/tests/vm/payload/*.sh)
 status=0
-"$vm_repo/scripts/vm/run_tests.sh" "$out" "${args[@]}" "$vm_repo"/tests/vm/payload/*.sh || status=$?
+"$vm_repo/scripts/vm/run_tests.sh" "$out" "${args[@]}" "${tests[@]}" || status=$?
 case "$status" in
   77) echo "SKIP: no cached VM image"; exit "$vm_skip" ;;
   124 | 125) echo "FAIL: the VM did not report (status $status); console: $out/console.log"; exit 1 ;;

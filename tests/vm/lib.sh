@@ -4,6 +4,9 @@
 
 vm_repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 vm_skip=77
+# The VM's architecture, as scripts/vm/ reads it (CTest sets it for the arm64 VM's tests).
+# shellcheck disable=SC2034 # read by the scripts that source this one
+vm_arch=${SELFSENSE_VM_ARCH:-amd64}
 
 # Skips (CTest SKIP_RETURN_CODE) when the image is not built, as on a machine that never ran
 # scripts/vm/image.sh; CI builds it first (scripts/setup.sh run_vm_tests).
