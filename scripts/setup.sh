@@ -55,10 +55,15 @@ fi
 if [ "$mode" = package ] || [ "$mode" = test ] || [ "$mode" = port ]; then
   packages+=(dpkg-dev lintian file)
 fi
-# The arm64 VM (scripts/vm/image.sh would install them itself, after an apt-get update of its
-# own): qemu-system-aarch64, and qemu-user-static with binfmt for the image's arm64 root.
+# The VMs (scripts/vm/image.sh would install them itself, after an apt-get update of its own,
+# and two image builds in the background would meet at dpkg's lock): debootstrap and e2fsprogs
+# for the images, qemu-system-x86 (test), qemu-system-aarch64 and qemu-user-static with binfmt
+# for the arm64 image's root.
 if [ "$mode" = test ] || [ "$mode" = port ]; then
-  packages+=(qemu-system-arm qemu-user-static binfmt-support)
+  packages+=(debootstrap e2fsprogs qemu-system-arm qemu-user-static binfmt-support)
+fi
+if [ "$mode" = test ]; then
+  packages+=(qemu-system-x86)
 fi
 
 # Cross builds (cmake/toolchains/): Debian's cross compilers and the target's libraries as
@@ -225,9 +230,27 @@ run_fuzz() {
 run_vm_tests() {  # run_vm_tests BUILD_DIR [ARCH]
   local dir=${1:-build} arch=${2:-amd64}
   say "vm: $arch image (cached under /var/cache/selfsense-vm/$arch)"
-  SELFSENSE_VM_ARCH=$arch scripts/vm/image.sh >"$dir/vm-image.log" 2>&1 || { tail -40 "$dir/vm-image.log"; exit 1; }
-  tail -3 "$dir/vm-image.log"
+  if [ -n "${vm_image_job[$arch]:-}" ]; then
+    wait "${vm_image_job[$arch]}" || { tail -40 "${vm_image_log[$arch]}"; echo "setup: the $arch VM image failed" >&2; exit 1; }
+    tail -3 "${vm_image_log[$arch]}"
+  else
+    SELFSENSE_VM_ARCH=$arch scripts/vm/image.sh >"$dir/vm-image.log" 2>&1 || { tail -40 "$dir/vm-image.log"; exit 1; }
+    tail -3 "$dir/vm-image.log"
+  fi
   run_tests "$dir" -L vm
+}
+
+# A VM image built in the background (run_vm_tests waits for it): cold, the amd64 image takes
+# about 5 minutes and the arm64 one about 20, mostly waiting for the mirror, the disk and dpkg
+# under emulation (7 minutes of CPU), so `test` starts both before its builds; image.sh builds
+# one at a time (a lock), and returns at once when the image is cached.
+declare -A vm_image_job=() vm_image_log=()
+start_vm_image() {  # start_vm_image ARCH
+  local arch=$1
+  mkdir -p build-vm
+  vm_image_log[$arch]=build-vm/image-$arch.log
+  SELFSENSE_VM_ARCH=$arch scripts/vm/image.sh >"${vm_image_log[$arch]}" 2>&1 &
+  vm_image_job[$arch]=$!
 }
 
 # The lock-free hand-over and the threads around the loop (rings, status seqlock, control
@@ -263,16 +286,12 @@ cross_configure() {
 # arm64 VM (vm_arm64.*, tests/vm/CMakeLists.txt): no second cpack.
 port_long='RuntimeModel.ModelIdentifiedAt1kHzRunsAt20kHz|Reconstruction.IdentifiedHysteresisCreepBeatsLinearOnHeldOutData|StressHysteresis.ReconstructsStressWhereTheAffineModelCannot'
 run_port() {
-  local begin=$SECONDS image
+  local begin=$SECONDS
+  # The arm64 VM image beside the cross build and the port's tests (`test` started it earlier).
+  [ -n "${vm_image_job[arm64]:-}" ] || start_vm_image arm64
   cross_configure arm64 -DSELFSENSE_BUILD_TESTS=ON -DSELFSENSE_WERROR=ON
-  # The arm64 VM image, when not cached, is built beside the cross build and the port's tests:
-  # cold it took 21 min at load average 7, but only 7 min of CPU (the rest waits for the mirror,
-  # the disk and the compilers); cached, image.sh returns at once.
-  SELFSENSE_VM_ARCH=arm64 scripts/vm/image.sh >build-arm64/vm-image-bg.log 2>&1 &
-  image=$!
   cmake --build build-arm64 -j "$jobs" --target selfsense_packaged selfsense_port_tests
   run_tests build-arm64 -L 'port|package' -LE vm -E "$port_long"
-  wait "$image" || { tail -40 build-arm64/vm-image-bg.log; echo "setup: the arm64 VM image failed" >&2; exit 1; }
   run_vm_tests build-arm64 arm64
   say "port: arm64 built, tested under qemu-user, packaged and run in the arm64 VM in $((SECONDS - begin)) s"
 }
@@ -317,6 +336,8 @@ case "$mode" in
     say "demo: done in $((SECONDS - setup_begin)) s; the page: $demo_build/main-job/main_job.html"
     ;;
   test)
+    start_vm_image amd64
+    [ ${#cross_failed[@]} -ne 0 ] || start_vm_image arm64
     check_format
     # Tests and benchmarks on, file by file: a build directory the demo configured has them off
     # and builds in batches (clang-tidy reads compile_commands.json, which then names the
