@@ -4,36 +4,18 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "selfsense/base/check.hpp"
+
 namespace selfsense::adaptation {
 
-namespace {
-
-bool fail(std::string* why, const std::string& message) {
-  if (why != nullptr) *why = message;
-  return false;
-}
-
-}  // namespace
-
 bool ThermalModelConfig::is_valid(const std::string& prefix, std::string* why) const {
-  const struct {
-    const char* key;
-    double value;
-  } finite[] = {{"thermal_resistance_k_per_w", resistance_k_per_w},
-                {"thermal_time_constant_s", time_constant_s},
-                {"ambient_degc", ambient_degc},
-                {"stack_volume_m3", stack_volume_m3},
-                {"max_power_w", max_power_w}};
-  for (const auto& f : finite) {
-    if (!std::isfinite(f.value)) return fail(why, prefix + f.key + ": must be finite");
-  }
-  if (!(resistance_k_per_w >= 0.0)) {
-    return fail(why, prefix + "thermal_resistance_k_per_w: must be >= 0");
-  }
-  if (!(time_constant_s > 0.0)) return fail(why, prefix + "thermal_time_constant_s: must be > 0");
-  if (!(stack_volume_m3 > 0.0)) return fail(why, prefix + "stack_volume_m3: must be > 0");
-  if (!(max_power_w > 0.0)) return fail(why, prefix + "max_power_w: must be > 0");
-  return true;
+  namespace check = base::check;
+  const auto key = [&prefix](const char* name) { return prefix + name; };
+  return check::non_negative(key("thermal_resistance_k_per_w"), resistance_k_per_w, why) &&
+         check::positive(key("thermal_time_constant_s"), time_constant_s, why) &&
+         check::finite(key("ambient_degc"), ambient_degc, why) &&
+         check::positive(key("stack_volume_m3"), stack_volume_m3, why) &&
+         check::positive(key("max_power_w"), max_power_w, why);
 }
 
 ThermalModel::ThermalModel(const ThermalModelConfig& config, double sample_time_s)

@@ -28,23 +28,23 @@ TEST(ThermalModelConfig, NamesTheViolatedKey) {
   EXPECT_TRUE(c.is_valid("adaptation.", &why)) << why;
   c.time_constant_s = 0.0;
   EXPECT_FALSE(c.is_valid("adaptation.", &why));
-  EXPECT_EQ(why, "adaptation.thermal_time_constant_s: must be > 0");
+  EXPECT_EQ(why, "adaptation.thermal_time_constant_s: 0 must be > 0");
   EXPECT_THROW(ThermalModel(c, kTs), std::invalid_argument);
   c = ThermalModelConfig{};
   c.resistance_k_per_w = -1.0;
   EXPECT_FALSE(c.is_valid("adaptation.", &why));
-  EXPECT_EQ(why, "adaptation.thermal_resistance_k_per_w: must be >= 0");
+  EXPECT_EQ(why, "adaptation.thermal_resistance_k_per_w: -1 must be >= 0");
   c = ThermalModelConfig{};
   c.ambient_degc = std::nan("");
   EXPECT_FALSE(c.is_valid("adaptation.", &why));
-  EXPECT_EQ(why, "adaptation.ambient_degc: must be finite");
+  EXPECT_EQ(why, "adaptation.ambient_degc: nan must be finite");
   // Checked with the estimator's configuration only when enabled.
   DriftEstimatorConfig d{};
   d.thermal.stack_volume_m3 = 0.0;
   EXPECT_TRUE(d.is_valid("adaptation.", &why));
   d.thermal.enabled = true;
   EXPECT_FALSE(d.is_valid("adaptation.", &why));
-  EXPECT_EQ(why, "adaptation.stack_volume_m3: must be > 0");
+  EXPECT_EQ(why, "adaptation.stack_volume_m3: 0 must be > 0");
   EXPECT_THROW(ThermalModel(ThermalModelConfig{}, 0.0), std::invalid_argument);
 }
 

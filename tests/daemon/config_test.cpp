@@ -155,7 +155,7 @@ TEST(DaemonConfig, TheAdaptationSectionIsReadStrictlyAndValidated) {
   const ConfigResult thermal_bad = load_sim(
       "adapt-thermal-bad", {{"thermal_model: false", "thermal_model: true"},
                             {"thermal_time_constant_s: 600.0", "thermal_time_constant_s: 0"}});
-  EXPECT_TRUE(has(thermal_bad, "adaptation.thermal_time_constant_s: must be > 0"))
+  EXPECT_TRUE(has(thermal_bad, "adaptation.thermal_time_constant_s: 0 must be > 0"))
       << thermal_bad.problems.front();
   const ConfigResult unknown = load_sim("adapt-unknown", {{"  compliance_per_k: 5.0e-4",
                                                            "  compliance_per_k: 5.0e-4\n"

@@ -44,7 +44,8 @@ struct ThermalModelConfig {
   double max_power_w{100.0};         // bound on |P| [W]
 
   // Every value finite; resistance >= 0; time constant, volume and power bound positive. *why
-  // names the key under `prefix` ("adaptation.thermal_time_constant_s: must be > 0").
+  // names the key under `prefix` in base/check.hpp's format
+  // ("adaptation.thermal_time_constant_s: 0 must be > 0").
   [[nodiscard]] bool is_valid(const std::string& prefix, std::string* why) const;
   friend bool operator==(const ThermalModelConfig&, const ThermalModelConfig&) = default;
 };
