@@ -7,6 +7,7 @@
 
 #include "candidates.hpp"
 #include "held_out.hpp"
+#include "selfsense/diagnosis/mode_undone.hpp"
 #include "selfsense/identification/transducer_fit.hpp"
 #include "text.hpp"
 
@@ -32,10 +33,13 @@ class Judge {
   [[nodiscard]] std::size_t half() const { return half_; }
 
   // The channel as the model would see it without the effect: a delay is undone by reading
-  // the record that much later (linear interpolation, the last sample held), a leak by the
-  // correction stage's inverse.
+  // the record that much later (linear interpolation, the last sample held), a mode by its
+  // offline inverse (mode_undone.hpp), a leak by the correction stage's inverse.
   [[nodiscard]] std::vector<double> undone(const models::ChannelCorrection& effect) const {
     const std::span<const double> x = ch_.recorded;
+    if (effect.dynamics_frequency_hz > 0.0) {
+      return mode_undone(x, effect.dynamics_frequency_hz, effect.dynamics_damping, s_.sample_time);
+    }
     std::vector<double> out(x.begin(), x.end());
     if (effect.empty()) return out;
     if (effect.delay_s > 0.0) {
@@ -238,8 +242,38 @@ std::optional<Reidentified> identified_whole(const Judge& judge,
   return r;
 }
 
-// One family of effects judged as a forecast: the effect chosen on the first half's fit (a
-// coarse grid, then `refine`'s neighbours of the best), judged by forecast_explains.
+// The effect of one family that fits the first half best: a coarse grid, then `refine`'s
+// neighbours of the best.
+template <typename Refine>
+Trial best_of(const Judge& judge, const std::vector<models::ChannelCorrection>& grid,
+              Refine&& refine) {
+  Trial best;
+  for (const models::ChannelCorrection& effect : grid) {
+    Trial t = judge.trial(effect);
+    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
+  }
+  if (best.forecast.empty()) return best;
+  for (const models::ChannelCorrection& effect : refine(best.effect)) {
+    Trial t = judge.trial(effect);
+    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
+  }
+  return best;
+}
+
+// `best` judged against `null` by forecast_explains; the side re-identified on the whole
+// record with it.
+std::optional<Reidentified> judged(const Judge& judge, const ChannelData& ch, const Trial& null,
+                                   const Trial& best, const Options& options, ShownBy evidence) {
+  const std::optional<double> explains =
+      forecast_explains(null, best, ch, judge.half(), options, evidence);
+  if (!explains) return std::nullopt;
+  std::optional<Reidentified> r = identified_whole(judge, best.effect, ch, *explains);
+  if (r) r->fit_explains = 1.0 - best.first_half_sse / null.first_half_sse;
+  return r;
+}
+
+// One family of effects judged as a forecast: the effect chosen on the first half's fit
+// (best_of), judged by forecast_explains.
 template <typename Refine>
 std::optional<Reidentified> judged_as_forecast(const Judge& judge, const ChannelData& ch,
                                                const std::vector<models::ChannelCorrection>& grid,
@@ -247,22 +281,9 @@ std::optional<Reidentified> judged_as_forecast(const Judge& judge, const Channel
                                                ShownBy evidence = ShownBy::kFitAndForecast) {
   const Trial null = judge.trial(models::ChannelCorrection{});
   if (null.forecast.empty()) return std::nullopt;
-  Trial best;
-  for (const models::ChannelCorrection& effect : grid) {
-    Trial t = judge.trial(effect);
-    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
-  }
+  const Trial best = best_of(judge, grid, std::forward<Refine>(refine));
   if (best.forecast.empty()) return std::nullopt;
-  for (const models::ChannelCorrection& effect : refine(best.effect)) {
-    Trial t = judge.trial(effect);
-    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
-  }
-  const std::optional<double> explains =
-      forecast_explains(null, best, ch, judge.half(), options, evidence);
-  if (!explains) return std::nullopt;
-  std::optional<Reidentified> r = identified_whole(judge, best.effect, ch, *explains);
-  if (r) r->fit_explains = 1.0 - best.first_half_sse / null.first_half_sse;
-  return r;
+  return judged(judge, ch, null, best, options, evidence);
 }
 
 // The model and recording allow a side to be re-identified on this channel.
@@ -367,10 +388,11 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
   return r;
 }
 
-std::optional<Reidentified> reidentified_delay(const models::TransducerModel& model,
-                                               const Signals& s, const ChannelData& ch,
-                                               const std::vector<double>& current,
-                                               const Options& options) {
+std::optional<Reidentified> reidentified_lag(const models::TransducerModel& model, const Signals& s,
+                                             const ChannelData& ch,
+                                             const std::vector<double>& current,
+                                             const Options& options,
+                                             const models::ChannelCorrection& mode_seed) {
   if (!reidentifiable(model, s, ch)) return std::nullopt;
   const Judge judge(model, s, ch);
   const double most = static_cast<double>(models::kMaxCorrectionDelaySamples) * s.sample_time;
@@ -392,14 +414,54 @@ std::optional<Reidentified> reidentified_delay(const models::TransducerModel& mo
     }
     return out;
   };
-  std::optional<Reidentified> r = judged_as_forecast(judge, ch, grid, neighbours, options);
+  const Trial null = judge.trial(models::ChannelCorrection{});
+  if (null.forecast.empty()) return std::nullopt;
+  Trial best = best_of(judge, grid, neighbours);
+  if (best.forecast.empty()) return std::nullopt;
+  // A fast, damped mode on S lags like a delay in the excitation's band; its resonance bends
+  // the response the other way above it ((4 zeta^2 - 1) / w0^2 against the delay's tau^2 / 2
+  // in s^2). Where the rounds fitted a mode, the modes around it (frequency within 2^(1/2),
+  // damping within 2) are tried the same way, and one replaces the delay where the delay leaves
+  // parsimony_ratio times its residual on the first half (the simpler lag otherwise).
+  bool mode = false;
+  if (!ch.sensed && mode_seed.dynamics_frequency_hz > 0.0) {
+    const auto with_mode = [](double hz, double zeta) {
+      models::ChannelCorrection c;
+      c.dynamics_frequency_hz = hz;
+      c.dynamics_damping = zeta;
+      return c;
+    };
+    std::vector<models::ChannelCorrection> modes;
+    for (const double f : {1.0 / std::sqrt(2.0), 1.0, std::sqrt(2.0)}) {
+      for (const double z : {0.5, 1.0, 2.0}) {
+        modes.push_back(
+            with_mode(f * mode_seed.dynamics_frequency_hz, z * mode_seed.dynamics_damping));
+      }
+    }
+    const auto mode_neighbours = [&](const models::ChannelCorrection& c) {
+      std::vector<models::ChannelCorrection> out;
+      for (const double f : {std::pow(2.0, 0.25), std::pow(2.0, -0.25)})
+        out.push_back(with_mode(f * c.dynamics_frequency_hz, c.dynamics_damping));
+      for (const double z : {std::sqrt(2.0), 1.0 / std::sqrt(2.0)})
+        out.push_back(with_mode(c.dynamics_frequency_hz, z * c.dynamics_damping));
+      return out;
+    };
+    Trial best_mode = best_of(judge, modes, mode_neighbours);
+    if (!best_mode.forecast.empty() &&
+        best.first_half_sse > options.parsimony_ratio * best_mode.first_half_sse) {
+      best = std::move(best_mode);
+      mode = true;
+    }
+  }
+  std::optional<Reidentified> r = judged(judge, ch, null, best, options, ShownBy::kFitAndForecast);
   if (!r) return std::nullopt;
-  r->candidate = &candidate_using(CorrectionTerm::kDelay);
-  r->terms = {CorrectionTerm::kDelay};
+  const CorrectionTerm term = mode ? CorrectionTerm::kDynamics : CorrectionTerm::kDelay;
+  r->candidate = &candidate_using(term);
+  r->terms = {term};
   r->finding.effect = r->candidate->effect;
   r->finding.where = where_it_changes(r->output, current);
   describe(r->finding, *r->candidate, r->correction, ch, s, current, r->output,
-           as_forecast(judge, s, ch, "delay"));
+           as_forecast(judge, s, ch, mode ? "mode" : "delay"));
   return r;
 }
 

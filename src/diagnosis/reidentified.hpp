@@ -137,17 +137,20 @@ struct StressReidentified {
 // The first candidate that carries `term`.
 [[nodiscard]] const Candidate& candidate_using(identification::CorrectionTerm term);
 
-// A delay on either channel judged the same way (docs/diagnose.md, "Delay re-identified"): a
-// base identified on a channel sampled late bends its fastest creep lags to the lag, and a delay
-// fitted after it then doubles what they already imitate where the drive is slow. The channel is
-// read that much later (the delay undone) for the identification; the delay is chosen on the
-// first half's fit over a quarter of a sample to 16 samples and judged as a forecast like the
-// leak.
-[[nodiscard]] std::optional<Reidentified> reidentified_delay(const models::TransducerModel& model,
-                                                             const Signals& s,
-                                                             const ChannelData& ch,
-                                                             const std::vector<double>& current,
-                                                             const Options& options);
+// A lag: a delay on either channel judged the same way (docs/diagnose.md, "Delay
+// re-identified"): a base identified on a channel sampled late bends its fastest creep lags to
+// the lag, and a delay fitted after it then doubles what they already imitate where the drive
+// is slow. The channel is read that much later (the delay undone) for the identification; the
+// delay is chosen on the first half's fit over a quarter of a sample to 16 samples and judged as
+// a forecast like the leak. On S, with `mode_seed` (the mode the rounds fitted: its frequency
+// and damping), the modes around it are identified the same way (the mode undone by
+// mode_undone.hpp); the best replaces the delay where the delay's first-half residual is more
+// than `parsimony_ratio` times the mode's (the rounds' rule for the simpler of two candidates:
+// the mode has one parameter more), and the finding is then `dynamics`.
+[[nodiscard]] std::optional<Reidentified> reidentified_lag(
+    const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
+    const std::vector<double>& current, const Options& options,
+    const models::ChannelCorrection& mode_seed = {});
 
 }  // namespace selfsense::diagnosis::detail
 

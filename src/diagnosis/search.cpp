@@ -67,10 +67,16 @@ void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>&
     }
     if (tried.empty()) break;
     if (round == 0) {
+      double mode_explains = -std::numeric_limits<double>::infinity();
       for (const Tried& t : tried) {
-        if (uses_term(*t.candidate, CorrectionTerm::kDelay) ||
-            uses_term(*t.candidate, CorrectionTerm::kDynamics)) {
+        const bool mode = uses_term(*t.candidate, CorrectionTerm::kDynamics);
+        if (mode || uses_term(*t.candidate, CorrectionTerm::kDelay)) {
           st.lag_explains = std::max(st.lag_explains, t.explains);
+        }
+        if (mode && t.explains > mode_explains) {
+          mode_explains = t.explains;
+          st.lag_mode.dynamics_frequency_hz = t.fit.correction.dynamics_frequency_hz;
+          st.lag_mode.dynamics_damping = t.fit.correction.dynamics_damping;
         }
       }
     }

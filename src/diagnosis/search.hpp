@@ -36,6 +36,9 @@ struct SearchState {
   // The most a lag (delay or mode) explained of the held-out residual in the first round,
   // significant or not: the evidence that decides whether a delay is worth re-identifying.
   double lag_explains{0.0};
+  // The mode (frequency and damping) of the first round's dynamics candidate, fitted or not: the
+  // seed of the modes tried beside the delay.
+  ChannelCorrection lag_mode{};
 };
 
 // Rounds of candidates until none is significant (or options.max_effects): findings appended.

@@ -156,6 +156,21 @@ bool ChannelCorrection::empty() const noexcept {
          hysteresis_weights.empty() && hinge_weights.empty();
 }
 
+ModeCoefficients mode_coefficients(double frequency_hz, double damping, double sample_time) {
+  const double w0 = 2.0 * std::numbers::pi * frequency_hz;
+  if (w0 * sample_time / 2.0 >= 0.95 * std::numbers::pi / 2.0) {
+    throw std::invalid_argument(
+        "correction.dynamics_frequency_hz: at or above Nyquist for this sample time");
+  }
+  const double k = w0 / std::tan(w0 * sample_time / 2.0);
+  const double a0 = k * k + 2.0 * damping * w0 * k + w0 * w0;
+  ModeCoefficients m;
+  m.b0 = w0 * w0 / a0;
+  m.a1 = (2.0 * w0 * w0 - 2.0 * k * k) / a0;
+  m.a2 = (k * k - 2.0 * damping * w0 * k + w0 * w0) / a0;
+  return m;
+}
+
 CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sample_time)
     : c_(correction) {
   std::string why;
@@ -179,17 +194,11 @@ CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sam
     alpha_[j] = -std::expm1(-c_.creep_eigenvalues[j] * sample_time);
   }
   if (c_.dynamics_frequency_hz > 0.0) {
-    const double w0 = 2.0 * std::numbers::pi * c_.dynamics_frequency_hz;
-    if (w0 * sample_time / 2.0 >= 0.95 * std::numbers::pi / 2.0) {
-      throw std::invalid_argument(
-          "correction.dynamics_frequency_hz: at or above Nyquist for this sample time");
-    }
-    const double k = w0 / std::tan(w0 * sample_time / 2.0);
-    const double z = c_.dynamics_damping;
-    const double a0 = k * k + 2.0 * z * w0 * k + w0 * w0;
-    a1_ = (2.0 * w0 * w0 - 2.0 * k * k) / a0;
-    a2_ = (k * k - 2.0 * z * w0 * k + w0 * w0) / a0;
-    b0_ = w0 * w0 / a0;
+    const ModeCoefficients m =
+        mode_coefficients(c_.dynamics_frequency_hz, c_.dynamics_damping, sample_time);
+    a1_ = m.a1;
+    a2_ = m.a2;
+    b0_ = m.b0;
     b1_ = 2.0 * b0_;
     b2_ = b0_;
     dynamics_ = true;

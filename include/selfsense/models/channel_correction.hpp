@@ -125,6 +125,20 @@ inline constexpr std::size_t kMaxCorrectionCreep{12};
 inline constexpr std::size_t kMaxCorrectionPlays{16};
 inline constexpr std::size_t kMaxCorrectionHinges{64};
 
+// The dynamics term's second-order low-pass (unity DC gain, natural frequency f0, damping zeta)
+// by the bilinear transform prewarped at f0:
+//   w[k] = b0 (v[k] + 2 v[k-1] + v[k-2]) - a1 w[k-1] - a2 w[k-2]
+// with k = w0 / tan(w0 Ts / 2), a0 = k^2 + 2 zeta w0 k + w0^2, b0 = w0^2 / a0,
+// a1 = 2 (w0^2 - k^2) / a0, a2 = (k^2 - 2 zeta w0 k + w0^2) / a0.
+// Throws std::invalid_argument at or above 0.95 Nyquist.
+struct ModeCoefficients {
+  double b0{1.0};
+  double a1{0.0};
+  double a2{0.0};
+};
+[[nodiscard]] ModeCoefficients mode_coefficients(double frequency_hz, double damping,
+                                                 double sample_time);
+
 class CorrectionStage {
  public:
   struct Inputs {
