@@ -240,6 +240,20 @@ std::int64_t run_due_updates(Device& device, std::int64_t next) {
 
 }  // namespace
 
+std::pair<std::string, int> parse_host_port(const std::string& text) {
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size()) {
+    throw std::invalid_argument("--modbus-tcp: '" + text + "' is not HOST:PORT");
+  }
+  std::size_t used = 0;
+  const int port = std::stoi(text.substr(colon + 1), &used);
+  if (used != text.size() - colon - 1 || port < 0 || port > 65535) {
+    throw std::invalid_argument("--modbus-tcp: port '" + text.substr(colon + 1) +
+                                "' must be within [0, 65535]");
+  }
+  return {text.substr(0, colon), port};
+}
+
 int serve_modbus_tcp(const ModbusSimDeviceOptions& options, const std::string& host, int port) {
   const StopSignals signals;
   Device device(options, mb::served_register_map());
