@@ -20,6 +20,7 @@ bool at_most(const std::string& name, std::size_t size, std::size_t limit, const
 }
 
 }  // namespace
+
 bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) const {
   const std::pair<const char*, double> scalars[] = {
       {"gain", gain},
