@@ -23,13 +23,13 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <cstring>
 #include <ctime>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "selfsense/base/errno_text.hpp"
 #include "selfsense/drivers/modbus/register_map.hpp"
 #include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
@@ -185,7 +185,7 @@ void set_priority(int priority) {
   if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
     static_cast<void>(
         std::fprintf(stderr, "sim-device: warning: SCHED_FIFO %d refused (%s); normal scheduling\n",
-                     priority, std::strerror(errno)));
+                     priority, base::errno_text(errno).c_str()));
   }
 }
 
@@ -204,7 +204,7 @@ bool wait_until(std::vector<pollfd>& fds, std::int64_t deadline, const StopSigna
     p.revents = 0;
   const int rc = ppoll(fds.data(), fds.size(), &ts, signals.wait_mask());
   if (rc < 0 && errno != EINTR)
-    throw std::runtime_error(std::string("ppoll: ") + std::strerror(errno));
+    throw std::runtime_error(std::string("ppoll: ") + base::errno_text(errno));
   return rc <= 0;
 }
 
