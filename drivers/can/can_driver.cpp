@@ -96,7 +96,7 @@ bool CanDriver::activate(std::string* why) {
   static_cast<void>(
       std::snprintf(ifr.ifr_name, sizeof(ifr.ifr_name), "%s", config_.interface.c_str()));
   if (::ioctl(socket_, SIOCGIFINDEX, &ifr) < 0) {
-    return fail("driver.interface: " + config_.interface + ": " + std::strerror(errno));
+    return fail("driver.interface: " + config_.interface + ": " + base::errno_text(errno));
   }
   const int index = ifr.ifr_ifindex;
   if (config_.fd) {
@@ -130,7 +130,7 @@ bool CanDriver::activate(std::string* why) {
   addr.can_family = AF_CAN;
   addr.can_ifindex = index;
   if (::bind(socket_, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)) < 0) {
-    return fail("driver.interface: bind to " + config_.interface + ": " + std::strerror(errno));
+    return fail("driver.interface: bind to " + config_.interface + ": " + base::errno_text(errno));
   }
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (wake_fd_ < 0) return fail(errno_text("can: eventfd"));

@@ -9,7 +9,8 @@
 
 #include <cerrno>
 #include <cstdio>
-#include <cstring>
+
+#include "selfsense/base/errno_text.hpp"
 
 namespace selfsense::drivers::can_sim {
 
@@ -24,7 +25,7 @@ NodeSocket::~NodeSocket() {
 bool NodeSocket::open(const can::CanConfig& layout, std::string* error) {
   fd_ = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);
   if (fd_ < 0) {
-    *error = std::string("socket(PF_CAN): ") + std::strerror(errno) +
+    *error = std::string("socket(PF_CAN): ") + base::errno_text(errno) +
              " (a kernel without SocketCAN? modprobe can can_raw)";
     return false;
   }
@@ -32,7 +33,7 @@ bool NodeSocket::open(const can::CanConfig& layout, std::string* error) {
   static_cast<void>(
       std::snprintf(ifr.ifr_name, sizeof(ifr.ifr_name), "%s", layout.interface.c_str()));
   if (::ioctl(fd_, SIOCGIFINDEX, &ifr) < 0) {
-    *error = "--can " + layout.interface + ": " + std::strerror(errno);
+    *error = "--can " + layout.interface + ": " + base::errno_text(errno);
     return false;
   }
   const int index = ifr.ifr_ifindex;
@@ -52,7 +53,7 @@ bool NodeSocket::open(const can::CanConfig& layout, std::string* error) {
   addr.can_ifindex = index;
   if (::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, &filter, sizeof(filter)) < 0 ||
       ::bind(fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)) < 0) {
-    *error = "--can " + layout.interface + ": bind: " + std::strerror(errno);
+    *error = "--can " + layout.interface + ": bind: " + base::errno_text(errno);
     return false;
   }
   return true;

@@ -23,13 +23,13 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <cstring>
 #include <ctime>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "selfsense/base/errno_text.hpp"
 #include "selfsense/drivers/modbus/register_map.hpp"
 #include "selfsense/drivers/sim/simulated_transducer.hpp"
 #include "selfsense/plant_io/plant_yaml.hpp"
@@ -185,7 +185,7 @@ void set_priority(int priority) {
   if (sched_setscheduler(0, SCHED_FIFO, &param) != 0) {
     static_cast<void>(
         std::fprintf(stderr, "sim-device: warning: SCHED_FIFO %d refused (%s); normal scheduling\n",
-                     priority, std::strerror(errno)));
+                     priority, base::errno_text(errno).c_str()));
   }
 }
 
@@ -204,7 +204,7 @@ bool wait_until(std::vector<pollfd>& fds, std::int64_t deadline, const StopSigna
     p.revents = 0;
   const int rc = ppoll(fds.data(), fds.size(), &ts, signals.wait_mask());
   if (rc < 0 && errno != EINTR)
-    throw std::runtime_error(std::string("ppoll: ") + std::strerror(errno));
+    throw std::runtime_error(std::string("ppoll: ") + base::errno_text(errno));
   return rc <= 0;
 }
 
@@ -239,6 +239,20 @@ std::int64_t run_due_updates(Device& device, std::int64_t next) {
 }
 
 }  // namespace
+
+std::pair<std::string, int> parse_host_port(const std::string& text) {
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == text.size()) {
+    throw std::invalid_argument("--modbus-tcp: '" + text + "' is not HOST:PORT");
+  }
+  std::size_t used = 0;
+  const int port = std::stoi(text.substr(colon + 1), &used);
+  if (used != text.size() - colon - 1 || port < 0 || port > 65535) {
+    throw std::invalid_argument("--modbus-tcp: port '" + text.substr(colon + 1) +
+                                "' must be within [0, 65535]");
+  }
+  return {text.substr(0, colon), port};
+}
 
 int serve_modbus_tcp(const ModbusSimDeviceOptions& options, const std::string& host, int port) {
   const StopSignals signals;

@@ -1,10 +1,10 @@
 #include <gpiod.h>
 
 #include <cerrno>
-#include <cstring>
 #include <ctime>
 #include <utility>
 
+#include "selfsense/base/errno_text.hpp"
 #include "selfsense/drivers/spi/gpio_line.hpp"
 
 namespace selfsense::drivers::spi {
@@ -19,7 +19,7 @@ bool GpiodLine::open(const char* consumer, std::string* why) {
   const auto fail = [&](const std::string& what) {
     if (why != nullptr) {
       *why = settings_.chip + " line " + std::to_string(settings_.offset) + ": " + what + ": " +
-             std::strerror(errno);
+             base::errno_text(errno);
     }
     close();
     return false;

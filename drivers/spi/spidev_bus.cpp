@@ -4,9 +4,9 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstring>
 #include <utility>
 
+#include "selfsense/base/errno_text.hpp"
 #include "selfsense/drivers/spi/spi_bus.hpp"
 
 namespace selfsense::drivers::spi {
@@ -19,7 +19,7 @@ SpidevBus::~SpidevBus() {
 
 bool SpidevBus::open(std::string* why) {
   const auto fail = [&](const char* what) {
-    if (why != nullptr) *why = settings_.device + ": " + what + ": " + std::strerror(errno);
+    if (why != nullptr) *why = settings_.device + ": " + what + ": " + base::errno_text(errno);
     close();
     return false;
   };

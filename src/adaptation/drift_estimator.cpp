@@ -4,18 +4,13 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "selfsense/base/check.hpp"
+
 namespace selfsense::adaptation {
 
-namespace {
-
-bool fail(std::string* why, const std::string& message) {
-  if (why != nullptr) *why = message;
-  return false;
-}
-
-}  // namespace
-
 bool DriftEstimatorConfig::is_valid(const std::string& prefix, std::string* why) const {
+  namespace check = base::check;
+  const auto key = [&prefix](const char* name) { return prefix + name; };
   const struct {
     const char* key;
     double value;
@@ -31,22 +26,20 @@ bool DriftEstimatorConfig::is_valid(const std::string& prefix, std::string* why)
                 {"compliance_per_k", compliance_per_k},
                 {"load_stiffness_ratio", load_stiffness_ratio}};
   for (const auto& f : finite) {
-    if (!std::isfinite(f.value)) return fail(why, prefix + f.key + ": must be finite");
+    if (!check::finite(key(f.key), f.value, why)) return false;
   }
-  if (!(min_field_step_v_per_m > 0.0)) {
-    return fail(why, prefix + "min_field_step_v_per_m: must be > 0");
-  }
-  if (!(max_interval_s > 0.0)) return fail(why, prefix + "max_interval_s: must be > 0");
-  if (!(memory_updates > 1.0)) return fail(why, prefix + "memory_updates: must be > 1");
-  if (!(initial_variance > 0.0)) return fail(why, prefix + "initial_variance: must be > 0");
-  if (!(max_relative_change > 0.0 && max_relative_change < 1.0)) {
-    return fail(why, prefix + "max_relative_change: must be in (0, 1)");
-  }
-  if (permittivity_per_k == 0.0) return fail(why, prefix + "permittivity_per_k: must not be 0");
-  if (!(load_stiffness_ratio >= 0.0)) {
-    return fail(why, prefix + "load_stiffness_ratio: must be >= 0");
-  }
-  return !thermal.enabled || thermal.is_valid(prefix, why);
+  const bool valid = check::positive(key("min_field_step_v_per_m"), min_field_step_v_per_m, why) &&
+                     check::positive(key("max_interval_s"), max_interval_s, why) &&
+                     check::require(memory_updates > 1.0, key("memory_updates"), memory_updates,
+                                    "must be > 1", why) &&
+                     check::positive(key("initial_variance"), initial_variance, why) &&
+                     check::require(max_relative_change > 0.0 && max_relative_change < 1.0,
+                                    key("max_relative_change"), max_relative_change,
+                                    "must be within (0, 1)", why) &&
+                     check::require(permittivity_per_k != 0.0, key("permittivity_per_k"),
+                                    permittivity_per_k, "must not be 0", why) &&
+                     check::non_negative(key("load_stiffness_ratio"), load_stiffness_ratio, why);
+  return valid && (!thermal.enabled || thermal.is_valid(prefix, why));
 }
 
 DriftEstimator::DriftEstimator(const DriftEstimatorConfig& config, double sample_time_s, double c0)

@@ -8,8 +8,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <functional>
-#include <future>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -21,6 +19,7 @@
 #include "commands.hpp"
 #include "selfsense/evaluation/field_signals.hpp"
 #include "selfsense/evaluation/model_runs.hpp"
+#include "selfsense/evaluation/work_runner.hpp"
 #include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/io/recording.hpp"
 #include "selfsense/model_io/geometry_yaml.hpp"
@@ -55,19 +54,6 @@ struct IdentifyOptions {
   double fastest{0.0};
   double slowest{0.0};
 };
-
-// The pieces of an identification (its two sides) on threads of their own beside this one, which
-// runs the first: on a machine with two free cores the two fits overlap. An exception of a piece
-// is rethrown once every piece has ended (a std::async future's destructor waits for it).
-void run_in_parallel(std::span<const std::function<void()>> work) {
-  if (work.empty()) return;
-  std::vector<std::future<void>> started;
-  for (const auto& piece : work.subspan(1))
-    started.push_back(std::async(std::launch::async, piece));
-  work.front()();
-  for (auto& f : started)
-    f.get();
-}
 
 void print_table(const std::vector<ChannelFigures>& fit, const std::vector<ChannelFigures>& held) {
   std::printf("  channel   fit nrmse   fit max   held-out nrmse   held-out max\n");
@@ -154,7 +140,7 @@ void run_identify(const IdentifyOptions& opt) {
   }
   const auto start = std::chrono::steady_clock::now();
   models::TransducerModel model =
-      identification::identify(part, *structure, sizes, run_in_parallel);
+      identification::identify(part, *structure, sizes, evaluation::run_on_threads);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   model.geometry = geometry;

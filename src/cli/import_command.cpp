@@ -41,13 +41,6 @@ struct ColumnsCommand {
   ColumnsOptions options{};
 };
 
-char delimiter_of(const std::string& text) {
-  if (text == "tab" || text == "\\t" || text == "\t") return '\t';
-  if (text == "space" || text == "whitespace" || text == " ") return ' ';
-  if (text.size() == 1) return text.front();
-  throw std::invalid_argument("--delimiter: '" + text + "' is not one character, 'tab' or 'space'");
-}
-
 void run_aixacct(AixacctCommand& cmd) {
   if (cmd.area_mm2 > 0.0) cmd.options.area_mm2 = cmd.area_mm2;
   if (cmd.thickness_m > 0.0) cmd.options.thickness_m = cmd.thickness_m;
@@ -63,7 +56,7 @@ void run_aixacct(AixacctCommand& cmd) {
 }
 
 void run_columns(ColumnsCommand& cmd) {
-  cmd.options.delimiter = delimiter_of(cmd.delimiter);
+  cmd.options.delimiter = importers::parse_delimiter(cmd.delimiter);
   cmd.options.map = parse_column_map(cmd.map);
   const io::Recording rec = import_columns(cmd.file, cmd.options);
   io::write_recording_csv(rec, cmd.out);

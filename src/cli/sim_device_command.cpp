@@ -9,7 +9,6 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <utility>
 
 #include "commands.hpp"
 #include "selfsense/daemon/config.hpp"
@@ -87,27 +86,12 @@ int run_can(const SimDeviceArgs& a) {
 
 // ---- Modbus -----------------------------------------------------------------------------------
 
-// "HOST:PORT" (the last colon splits; PORT 0 picks a free port and prints it).
-std::pair<std::string, int> host_port(const std::string& s) {
-  const std::size_t colon = s.rfind(':');
-  if (colon == std::string::npos || colon == 0 || colon + 1 == s.size()) {
-    throw std::invalid_argument("--modbus-tcp: '" + s + "' is not HOST:PORT");
-  }
-  std::size_t used = 0;
-  const int port = std::stoi(s.substr(colon + 1), &used);
-  if (used != s.size() - colon - 1 || port < 0 || port > 65535) {
-    throw std::invalid_argument("--modbus-tcp: port '" + s.substr(colon + 1) +
-                                "' must be within [0, 65535]");
-  }
-  return {s.substr(0, colon), port};
-}
-
 int run_modbus(const SimDeviceArgs& a) {
   drivers::modbus_sim::ModbusSimDeviceOptions o = a.modbus;
   if (!a.plant.empty()) o.plant = a.plant;
   o.rate_hz = a.rate_hz;
   if (!a.modbus_tcp.empty()) {
-    const auto [host, port] = host_port(a.modbus_tcp);
+    const auto [host, port] = drivers::modbus_sim::parse_host_port(a.modbus_tcp);
     return drivers::modbus_sim::serve_modbus_tcp(o, host, port);
   }
   return drivers::modbus_sim::serve_modbus_rtu(o, a.modbus_rtu);

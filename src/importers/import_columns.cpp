@@ -46,6 +46,14 @@ void convert(io::Recording& rec, const char* terminal, const char* field, double
 
 }  // namespace
 
+char parse_delimiter(std::string_view text) {
+  if (text == "tab" || text == "\\t" || text == "\t") return '\t';
+  if (text == "space" || text == "whitespace" || text == " ") return ' ';
+  if (text.size() == 1) return text.front();
+  throw std::invalid_argument("--delimiter: '" + std::string(text) +
+                              "' is not one character, 'tab' or 'space'");
+}
+
 std::vector<ColumnMap> parse_column_map(std::string_view map) {
   std::vector<ColumnMap> out;
   for (const std::string_view item : split_cells(map, ',')) {

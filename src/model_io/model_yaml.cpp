@@ -6,13 +6,13 @@
 
 #include <array>
 #include <cerrno>
-#include <cstring>
 #include <optional>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
 
 #include "geometry_fields.hpp"
+#include "selfsense/base/errno_text.hpp"
 #include "selfsense/io/yaml_map.hpp"
 
 namespace selfsense::models {
@@ -412,7 +412,7 @@ void save_model(const TransducerModel& model, const std::filesystem::path& path,
     const int error = errno;
     static_cast<void>(::unlink(temp.c_str()));
     throw std::runtime_error(path.string() + ": cannot write the model (" + what + ": " +
-                             std::strerror(error) + ")");
+                             base::errno_text(error) + ")");
   };
   const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) fail("open");

@@ -5,12 +5,18 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "selfsense/base/check.hpp"
+
 namespace selfsense::models {
 namespace {
 
-bool fail(std::string* why, const std::string& message) {
-  if (why != nullptr) *why = message;
-  return false;
+// "<name>: has 5 terms, at most 4" unless size <= limit.
+bool at_most(const std::string& name, std::size_t size, std::size_t limit, const char* what,
+             std::string* why) {
+  return size <= limit || base::check::fail(name,
+                                            "has " + std::to_string(size) + " " + what +
+                                                ", at most " + std::to_string(limit),
+                                            why);
 }
 
 }  // namespace
@@ -41,105 +47,77 @@ bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) co
       {"dynamics_damping", dynamics_damping},
       {"leakage_tau_s", leakage_tau_s},
       {"delay_s", delay_s}};
-  for (const auto& [key, value] : scalars) {
-    if (!std::isfinite(value)) return fail(why, prefix + "." + key + ": must be finite");
+  namespace check = base::check;
+  const auto key = [&prefix](const char* name) { return prefix + "." + name; };
+  for (const auto& [name, value] : scalars) {
+    if (!check::finite(key(name), value, why)) return false;
   }
-  if (creep_weights.size() != creep_eigenvalues.size()) {
-    return fail(why, prefix + ".creep_weights: needs one weight per eigenvalue");
-  }
-  if (creep_eigenvalues.size() > kMaxCorrectionCreep) {
-    return fail(why, prefix + ".creep_eigenvalues: at most " + std::to_string(kMaxCorrectionCreep) +
-                         " terms");
-  }
-  for (std::size_t i = 0; i < creep_eigenvalues.size(); ++i) {
-    if (!(std::isfinite(creep_eigenvalues[i]) && creep_eigenvalues[i] > 0.0)) {
-      return fail(why, prefix + ".creep_eigenvalues[" + std::to_string(i) + "]: must be > 0");
-    }
-    if (!std::isfinite(creep_weights[i])) {
-      return fail(why, prefix + ".creep_weights[" + std::to_string(i) + "]: must be finite");
-    }
-  }
-  if (drive_creep_weights.size() != drive_creep_eigenvalues.size()) {
-    return fail(why, prefix + ".drive_creep_weights: needs one weight per eigenvalue");
-  }
-  if (drive_creep_eigenvalues.size() > kMaxCorrectionCreep) {
-    return fail(why, prefix + ".drive_creep_eigenvalues: at most " +
-                         std::to_string(kMaxCorrectionCreep) + " terms");
-  }
-  for (std::size_t i = 0; i < drive_creep_eigenvalues.size(); ++i) {
-    if (!(std::isfinite(drive_creep_eigenvalues[i]) && drive_creep_eigenvalues[i] > 0.0)) {
-      return fail(why, prefix + ".drive_creep_eigenvalues[" + std::to_string(i) + "]: must be > 0");
-    }
-    if (!std::isfinite(drive_creep_weights[i])) {
-      return fail(why, prefix + ".drive_creep_weights[" + std::to_string(i) + "]: must be finite");
-    }
-  }
-  if (dynamics_frequency_hz < 0.0) {
-    return fail(why, prefix + ".dynamics_frequency_hz: must be >= 0 (0: none)");
-  }
-  if (dynamics_frequency_hz > 0.0 && !(dynamics_damping > 0.0)) {
-    return fail(why, prefix + ".dynamics_damping: must be > 0 with a dynamics frequency");
-  }
-  if (leakage_tau_s < 0.0) return fail(why, prefix + ".leakage_tau_s: must be >= 0 (0: none)");
-  if (delay_s < 0.0) return fail(why, prefix + ".delay_s: must be >= 0");
-  if (1.0 + gain <= 0.0) return fail(why, prefix + ".gain: 1 + gain must be > 0");
-  return plays_valid(prefix, why);
+  return check::same_size(key("creep_weights"), creep_weights.size(), key("creep_eigenvalues"),
+                          creep_eigenvalues.size(), why) &&
+         at_most(key("creep_eigenvalues"), creep_eigenvalues.size(), kMaxCorrectionCreep, "terms",
+                 why) &&
+         check::all_positive(key("creep_eigenvalues"), creep_eigenvalues, why) &&
+         check::all_finite(key("creep_weights"), creep_weights, why) &&
+         check::same_size(key("drive_creep_weights"), drive_creep_weights.size(),
+                          key("drive_creep_eigenvalues"), drive_creep_eigenvalues.size(), why) &&
+         at_most(key("drive_creep_eigenvalues"), drive_creep_eigenvalues.size(),
+                 kMaxCorrectionCreep, "terms", why) &&
+         check::all_positive(key("drive_creep_eigenvalues"), drive_creep_eigenvalues, why) &&
+         check::all_finite(key("drive_creep_weights"), drive_creep_weights, why) &&
+         check::require(dynamics_frequency_hz >= 0.0, key("dynamics_frequency_hz"),
+                        dynamics_frequency_hz, "must be >= 0 (0: none)", why) &&
+         check::require(dynamics_frequency_hz == 0.0 || dynamics_damping > 0.0,
+                        key("dynamics_damping"), dynamics_damping,
+                        "must be > 0 with a dynamics frequency", why) &&
+         check::require(leakage_tau_s >= 0.0, key("leakage_tau_s"), leakage_tau_s,
+                        "must be >= 0 (0: none)", why) &&
+         check::non_negative(key("delay_s"), delay_s, why) &&
+         check::require(1.0 + gain > 0.0, key("gain"), gain, "must be > -1", why) &&
+         plays_valid(prefix, why);
 }
 
 bool ChannelCorrection::plays_valid(const std::string& prefix, std::string* why) const {
-  if (hysteresis_weights.size() != hysteresis_thresholds.size()) {
-    return fail(why, prefix + ".hysteresis_weights: needs one weight per threshold");
-  }
-  if (hysteresis_thresholds.size() > kMaxCorrectionPlays) {
-    return fail(why, prefix + ".hysteresis_thresholds: at most " +
-                         std::to_string(kMaxCorrectionPlays) + " plays");
-  }
-  for (std::size_t i = 0; i < hysteresis_thresholds.size(); ++i) {
-    const double r = hysteresis_thresholds[i];
-    const double before = i == 0 ? 0.0 : hysteresis_thresholds[i - 1];
-    if (!(std::isfinite(r) && r > before)) {
-      return fail(why, prefix + ".hysteresis_thresholds[" + std::to_string(i) +
-                           "]: must be > 0 and increasing");
-    }
-    if (!std::isfinite(hysteresis_weights[i])) {
-      return fail(why, prefix + ".hysteresis_weights[" + std::to_string(i) + "]: must be finite");
-    }
-  }
-  if (hinge_levels.size() != hinge_thresholds.size() ||
-      hinge_weights.size() != hinge_thresholds.size()) {
-    return fail(why, prefix + ".hinge_levels: hinge thresholds, levels and weights differ in size");
-  }
-  if (hinge_thresholds.size() > kMaxCorrectionHinges) {
-    return fail(why, prefix + ".hinge_thresholds: at most " + std::to_string(kMaxCorrectionHinges) +
-                         " hinges");
+  namespace check = base::check;
+  const auto key = [&prefix](const char* name) { return prefix + "." + name; };
+  if (!(check::same_size(key("hysteresis_weights"), hysteresis_weights.size(),
+                         key("hysteresis_thresholds"), hysteresis_thresholds.size(), why) &&
+        at_most(key("hysteresis_thresholds"), hysteresis_thresholds.size(), kMaxCorrectionPlays,
+                "plays", why) &&
+        check::strictly_increasing_above(key("hysteresis_thresholds"), hysteresis_thresholds, 0.0,
+                                         why) &&
+        check::all_finite(key("hysteresis_weights"), hysteresis_weights, why) &&
+        check::same_size(key("hinge_levels"), hinge_levels.size(), key("hinge_thresholds"),
+                         hinge_thresholds.size(), why) &&
+        check::same_size(key("hinge_weights"), hinge_weights.size(), key("hinge_thresholds"),
+                         hinge_thresholds.size(), why) &&
+        at_most(key("hinge_thresholds"), hinge_thresholds.size(), kMaxCorrectionHinges, "hinges",
+                why) &&
+        check::all_finite(key("hinge_levels"), hinge_levels, why) &&
+        check::all_finite(key("hinge_weights"), hinge_weights, why))) {
+    return false;
   }
   for (std::size_t h = 0; h < hinge_thresholds.size(); ++h) {
     const double r = hinge_thresholds[h];
     const bool known =
         r == 0.0 || std::find(hysteresis_thresholds.begin(), hysteresis_thresholds.end(), r) !=
                         hysteresis_thresholds.end();
-    if (!known) {
-      return fail(why, prefix + ".hinge_thresholds[" + std::to_string(h) +
-                           "]: must be 0 or one of hysteresis_thresholds");
-    }
-    if (!std::isfinite(hinge_levels[h]) || !std::isfinite(hinge_weights[h])) {
-      return fail(why, prefix + ".hinge_levels[" + std::to_string(h) +
-                           "]: level and weight must be finite");
+    if (!check::require(known, key("hinge_thresholds") + "[" + std::to_string(h) + "]", r,
+                        "must be 0 or one of hysteresis_thresholds", why)) {
+      return false;
     }
   }
   return true;
 }
 
 bool ChannelCorrection::invertible(const std::string& prefix, std::string* why) const {
-  if (dynamics_frequency_hz != 0.0) {
-    return fail(why, prefix +
-                         ".dynamics_frequency_hz: dynamics on the sensed channel are not "
-                         "inverted by the reconstruction");
-  }
-  if (sensed_quadratic != 0.0) {
-    return fail(why, prefix + ".sensed_quadratic: only the strain channel may use it");
-  }
-  return true;
+  namespace check = base::check;
+  return check::require(dynamics_frequency_hz == 0.0, prefix + ".dynamics_frequency_hz",
+                        dynamics_frequency_hz,
+                        "must be 0 (dynamics on the sensed channel are not inverted by the "
+                        "reconstruction)",
+                        why) &&
+         check::require(sensed_quadratic == 0.0, prefix + ".sensed_quadratic", sensed_quadratic,
+                        "must be 0 (only the strain channel may use it)", why);
 }
 
 bool ChannelCorrection::empty() const noexcept {

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "carry_over.hpp"
+#include "selfsense/base/check.hpp"
 
 namespace selfsense::models {
 namespace {
@@ -198,17 +199,11 @@ Out gated_step(const detail::InputGate& gate, detail::HeldInputs& held, Out& las
 }  // namespace
 
 bool RuntimeOptions::is_valid(std::string* why) const {
-  const auto fail = [why](const char* message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
-  if (!(std::isfinite(sample_time) && sample_time >= 0.0)) {
-    return fail("runtime.sample_time: must be finite and >= 0 (0: the model's own)");
-  }
-  if (!(std::isfinite(range_margin) && range_margin >= 0.0)) {
-    return fail("runtime.range_margin: must be finite and >= 0");
-  }
-  return true;
+  namespace check = base::check;
+  return check::finite("runtime.sample_time", sample_time, why) &&
+         check::require(sample_time >= 0.0, "runtime.sample_time", sample_time,
+                        "must be >= 0 (0: the model's own)", why) &&
+         check::non_negative("runtime.range_margin", range_margin, why);
 }
 
 namespace detail {

@@ -18,34 +18,36 @@ double StressHysteresisSide::evaluate(std::span<const double> q, double t) const
 }
 
 bool StressHysteresisModel::is_valid(std::string* why) const {
-  const auto fail = [why](const std::string& message) {
-    if (why != nullptr) *why = message;
-    return false;
-  };
+  namespace check = operators::check;  // base::check
   if (basis.thresholds.empty() || basis.thresholds.front() != 0.0) {
-    return fail("vectorial.thresholds: must start with 0 (the linear term)");
+    return check::fail("vectorial.thresholds", "must start with 0 (the linear term)", why);
   }
   if (!operators::check::strictly_increasing_above(
           "vectorial.thresholds", std::span(basis.thresholds).subspan(1), 0.0, why)) {
     return false;
   }
-  if (!basis.hinge_rows.empty()) return fail("vectorial: hinges are not part of this model");
+  if (!basis.hinge_rows.empty())
+    return check::fail("vectorial", "hinges are not part of this model", why);
   for (std::size_t i = 0; i < basis.creep_rows.size(); ++i) {
     if (basis.creep_rows[i] >= basis.plays() ||
         (i > 0 && basis.creep_rows[i] <= basis.creep_rows[i - 1])) {
-      return fail("vectorial.creep.rows: must be increasing play indices below " +
-                  std::to_string(basis.plays()));
+      return check::fail("vectorial.creep.rows",
+                         "must be increasing play indices below " + std::to_string(basis.plays()),
+                         why);
     }
   }
   if (basis.creep_rows.empty() != basis.eigenvalues.empty()) {
-    return fail("vectorial.creep: rows and eigenvalues must both be given or both be empty");
+    return check::fail("vectorial.creep",
+                       "rows and eigenvalues must both be given or both be empty", why);
   }
   for (const double l : basis.eigenvalues) {
     if (!(l > 0.0) || !std::isfinite(l)) {
-      return fail("vectorial.creep.eigenvalues: must be finite and > 0");
+      return check::fail("vectorial.creep.eigenvalues", "must be finite and > 0", why);
     }
   }
-  if (!(stress_max > stress_min)) return fail("vectorial.stress_range: max must be > min");
+  if (!(stress_max > stress_min)) {
+    return check::fail("vectorial.stress_range", "max must be > min", why);
+  }
   for (const auto& [name, side] :
        {std::pair{"sensor", &sensor}, std::pair{"actuator", &actuator}}) {
     if (!*side) continue;

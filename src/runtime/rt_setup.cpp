@@ -11,8 +11,9 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <string>
+
+#include "selfsense/base/errno_text.hpp"
 
 namespace selfsense::runtime {
 namespace {
@@ -45,7 +46,7 @@ CpuLatencyRequest::CpuLatencyRequest(int us, std::string* why) {
   if (fd >= 0) ::close(fd);
   if (why != nullptr) {
     *why = std::string("CPU wake-up latency ") + std::to_string(us) + " us (" + path +
-           "): " + std::strerror(e) +
+           "): " + base::errno_text(e) +
            " (written by root only unless a udev rule grants it; deep idle states stay allowed)";
   }
 }
@@ -76,7 +77,7 @@ RtSetupResult setup_realtime(const RtOptions& options) {
     static_cast<void>(mallopt(M_MMAP_MAX, 0));
   } else {
     const int e = errno;
-    r.problems.push_back(std::string("mlockall: ") + std::strerror(e) +
+    r.problems.push_back(std::string("mlockall: ") + base::errno_text(e) +
                          " (needs CAP_IPC_LOCK or RLIMIT_MEMLOCK, now " +
                          limit_text(RLIMIT_MEMLOCK) + " bytes)");
   }
@@ -87,7 +88,7 @@ RtSetupResult setup_realtime(const RtOptions& options) {
     r.fifo = true;
   } else {
     r.problems.push_back(
-        "SCHED_FIFO priority " + std::to_string(options.priority) + ": " + std::strerror(fifo) +
+        "SCHED_FIFO priority " + std::to_string(options.priority) + ": " + base::errno_text(fifo) +
         " (needs CAP_SYS_NICE or RLIMIT_RTPRIO >= " + std::to_string(options.priority) + ", now " +
         limit_text(RLIMIT_RTPRIO) + ")");
   }
@@ -100,7 +101,7 @@ RtSetupResult setup_realtime(const RtOptions& options) {
       r.affinity = true;
     } else {
       r.problems.push_back("CPU affinity to CPU " + std::to_string(options.cpu) + ": " +
-                           std::strerror(aff));
+                           base::errno_text(aff));
     }
   } else {
     r.affinity = true;

@@ -29,6 +29,10 @@ struct ColumnMap {
 // bad item (bad column number, empty or repeated name, unknown unit).
 [[nodiscard]] std::vector<ColumnMap> parse_column_map(std::string_view map);
 
+// The delimiter as a user writes it: one character, "tab" (or "\\t") or "space" (or
+// "whitespace"; ' ', runs of blanks and tabs). Throws std::invalid_argument otherwise.
+[[nodiscard]] char parse_delimiter(std::string_view text);
+
 struct ColumnsOptions {
   char delimiter{','};  // ' ': runs of blanks and tabs
   std::vector<ColumnMap> map{};

@@ -4,7 +4,7 @@
 // field in kV/mm; the setpoint, the self-sensed estimate and the plant's true value; the
 // tracking error under each run over the samples its figure counts; spans outside the armed
 // state shaded and the moment a fault latched marked. One self-contained file, no scripts or
-// network resources. This file only draws; the command reads the recordings.
+// network resources. This file only draws; evaluation/main_job_input.hpp reads the recordings.
 #pragma once
 
 #include <cstdint>

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 
 namespace selfsense::drivers::modbus_sim {
 
@@ -15,6 +16,10 @@ struct ModbusSimDeviceOptions {
   int baud{115200};  // RTU
   int priority{0};   // SCHED_FIFO priority of the server; 0: normal scheduling
 };
+
+// "HOST:PORT" (the last colon splits; PORT 0 picks a free port, which the server prints).
+// Throws std::invalid_argument naming --modbus-tcp otherwise.
+[[nodiscard]] std::pair<std::string, int> parse_host_port(const std::string& text);
 
 // Serves until SIGINT or SIGTERM; returns the exit status (0 after a signal).
 int serve_modbus_tcp(const ModbusSimDeviceOptions& options, const std::string& host, int port);

@@ -1,19 +1,29 @@
 // identify() hands the two sides' fits to the caller's runner (transducer_fit.hpp): run on two
-// threads they give the model that one after the other gives, to the last bit.
+// threads by the runner `selfsense identify` uses (evaluation::run_on_threads) they give the model
+// that one after the other gives, to the last bit; the runner waits for every piece and rethrows.
+#include "selfsense/evaluation/work_runner.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <functional>
-#include <future>
 #include <numbers>
 #include <optional>
 #include <span>
+#include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "selfsense/identification/transducer_fit.hpp"
 
-namespace selfsense::identification {
+namespace selfsense::evaluation {
 namespace {
+
+using identification::defaults_for;
+using identification::IdentificationOptions;
+using identification::identify;
+using identification::TransducerSignals;
+using identification::WorkRunner;
 
 void expect_same_side(const std::optional<models::SideModel>& a,
                       const std::optional<models::SideModel>& b) {
@@ -49,11 +59,7 @@ TEST(WorkRunner, SidesOnTwoThreadsGiveTheModelOfOneAfterTheOther) {
   std::size_t pieces = 0;
   const WorkRunner on_threads = [&pieces](std::span<const std::function<void()>> work) {
     pieces = work.size();
-    std::vector<std::future<void>> started;
-    for (const auto& piece : work)
-      started.push_back(std::async(std::launch::async, piece));
-    for (auto& f : started)
-      f.get();
+    run_on_threads(work);
   };
   const models::TransducerModel one_after_the_other =
       identify(signals, models::Structure::kHysteresisCreep, o);
@@ -64,5 +70,26 @@ TEST(WorkRunner, SidesOnTwoThreadsGiveTheModelOfOneAfterTheOther) {
   expect_same_side(parallel.actuator, one_after_the_other.actuator);
 }
 
+TEST(WorkRunner, RunsEveryPieceOnAThreadBesideTheCallersAndRethrowsAfterAll) {
+  const std::thread::id caller = std::this_thread::get_id();
+  std::vector<std::thread::id> where(3);
+  bool last_ran = false;
+  const std::vector<std::function<void()>> work{[&] { where[0] = std::this_thread::get_id(); },
+                                                [&] {
+                                                  where[1] = std::this_thread::get_id();
+                                                  throw std::runtime_error("second");
+                                                },
+                                                [&] {
+                                                  where[2] = std::this_thread::get_id();
+                                                  last_ran = true;
+                                                }};
+  EXPECT_THROW(run_on_threads(work), std::runtime_error);
+  EXPECT_TRUE(last_ran);
+  EXPECT_EQ(where[0], caller);
+  EXPECT_NE(where[1], caller);
+  EXPECT_NE(where[2], caller);
+  run_on_threads({});  // nothing to run
+}
+
 }  // namespace
-}  // namespace selfsense::identification
+}  // namespace selfsense::evaluation
