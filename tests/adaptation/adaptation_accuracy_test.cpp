@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
+#include "selfsense/adaptation/temperature_fit.hpp"
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/models/reconstructor.hpp"
@@ -54,6 +55,43 @@ const models::TransducerModel& main_job_model() {
     return identification::identify(
         {r.e, r.d, r.t, r.s, 1.0 / f.plant.sample_rate_hz}, models::Structure::kPreisachCreep,
         identification::defaults_for(models::Structure::kPreisachCreep));
+  }();
+  return model;
+}
+
+// The main job's model with temperature coefficients fitted on a ramp recording (issue 24 items 1
+// and 5): the identification plant and excitation (config/plant/reconstruction.yaml, seed 2:
+// other noise than the model's recording) with config/plant/temperature.yaml's coefficients,
+// warming 25 -> 55 degC. The validation recordings' excitation (mix) is never seen.
+const models::TransducerModel& model_with_coefficients() {
+  static const models::TransducerModel model = [] {
+    plant::PlantFile f =
+        plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction.yaml");
+    f.plant.temperature =
+        plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/temperature.yaml")
+            .plant.temperature;
+    f.plant.seed = 2;
+    plant::Excitation ex =
+        plant::make_excitation("identification", f.excitation, f.plant.sample_rate_hz, 2);
+    f.excitation.temperature = {25.0, 55.0};
+    plant::apply_load_and_temperature(f.excitation, f.plant.sample_rate_hz, ex);
+    const Recorded r = record(f.plant, ex);
+    models::TransducerModel m = main_job_model();
+    const adaptation::TemperatureFitResult fit =
+        adaptation::fit_temperature(m, {r.e, r.d, r.t, r.s, r.temp}, 25.0);
+    const models::SideTemperature& s = fit.coefficients.sensor;
+    const models::SideTemperature& a = fit.coefficients.actuator;
+    std::printf(
+        "fitted on %zu samples (%.0f s): sensor L %+.3e %+.3e, H %+.3e %+.3e, d %+.3e %+.3e; "
+        "actuator L %+.3e %+.3e, H %+.3e %+.3e, s %+.3e %+.3e; residual RMS sensor %.3g -> "
+        "%.3g C/m^2, actuator %.3g -> %.3g\n",
+        fit.samples, static_cast<double>(r.e.size()) / f.plant.sample_rate_hz, s.linear.per_k,
+        s.linear.per_k2, s.loop.per_k, s.loop.per_k2, s.coupling.per_k, s.coupling.per_k2,
+        a.linear.per_k, a.linear.per_k2, a.loop.per_k, a.loop.per_k2, a.coupling.per_k,
+        a.coupling.per_k2, fit.sensor_rms_before, fit.sensor_rms_after, fit.actuator_rms_before,
+        fit.actuator_rms_after);
+    m.temperature = fit.coefficients;
+    return m;
   }();
   return model;
 }
@@ -102,9 +140,11 @@ struct Figures {
   double temperature_max_k{0.0};
 };
 
-// kind: 0 the model as identified, 1 adapted from E and D, 2 the recorded temperature.
+// kind: 0 the model as identified, 1 adapted from E and D, 2 the recorded temperature, 3 the
+// recorded temperature with the fitted coefficients (model_with_coefficients), 4 adapted from E
+// and D with the fitted coefficients.
 Figures reconstruct(const Recorded& r, int kind, std::size_t settle) {
-  const models::TransducerModel& model = main_job_model();
+  const models::TransducerModel& model = kind >= 3 ? model_with_coefficients() : main_job_model();
   std::vector<double> s_hat(r.e.size());
   std::vector<double> t_hat(r.e.size());
   double sq = 0.0;
@@ -118,10 +158,10 @@ Figures reconstruct(const Recorded& r, int kind, std::size_t settle) {
     }
   } else {
     adaptation::DriftEstimatorConfig config{};
-    config.frozen = kind == 2;
+    config.frozen = kind == 2 || kind == 3;
     adaptation::AdaptedReconstruction rec(model, config);
     for (std::size_t k = 0; k < r.e.size(); ++k) {
-      if (kind == 2) rec.set_temperature(r.temp[k]);
+      if (kind == 2 || kind == 3) rec.set_temperature(r.temp[k]);
       const auto est = rec.step(r.e[k], r.d[k]);
       s_hat[k] = est.strain;
       t_hat[k] = est.stress;
@@ -158,9 +198,13 @@ TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
   const Figures none = reconstruct(r, 0, settle);
   const Figures adapted = reconstruct(r, 1, settle);
   const Figures measured = reconstruct(r, 2, settle);
+  const Figures fitted = reconstruct(r, 3, settle);
+  const Figures adapted_fitted = reconstruct(r, 4, settle);
   print("as identified", none);
   print("adapted (E, D only)", adapted);
   print("recorded temperature", measured);
+  print("recorded, fitted coef", fitted);
+  print("adapted, fitted coef", adapted_fitted);
   RecordProperty("S_hat_nrmse_adapted", std::to_string(adapted.strain.nrmse));
   RecordProperty("T_hat_nrmse_adapted", std::to_string(adapted.stress.nrmse));
   EXPECT_LE(adapted.strain.nrmse, 0.0040);
@@ -193,9 +237,13 @@ TEST(AdaptationAccuracy, SlowRandomSwingsWithoutTemperatureInput) {
   const Figures none = reconstruct(r, 0, settle);
   const Figures adapted = reconstruct(r, 1, settle);
   const Figures measured = reconstruct(r, 2, settle);
+  const Figures fitted = reconstruct(r, 3, settle);
+  const Figures adapted_fitted = reconstruct(r, 4, settle);
   print("swings, as identified", none);
   print("swings, adapted", adapted);
   print("swings, recorded temp", measured);
+  print("swings, fitted coef", fitted);
+  print("swings, adapted fitted", adapted_fitted);
   EXPECT_LE(adapted.strain.nrmse, 0.0053);
   EXPECT_LE(adapted.stress.nrmse, 0.018);
   EXPECT_LE(adapted.temperature_rms_k, 5.0);
