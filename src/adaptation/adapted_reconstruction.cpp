@@ -187,8 +187,14 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field,
 
 void AdaptedReconstruction::set_temperature(double degc) noexcept {
   if (!std::isfinite(degc)) return;
-  estimator_.set_temperature(degc);
   measured_degc_ = degc;
+  if (!coefficients_) {
+    estimator_.set_temperature(degc);
+    return;
+  }
+  const double dt = degc - coefficients_->reference_degc;  // the fitted sensor side's drift
+  estimator_.set_drift(coefficients_->sensor.linear.scale(dt) - 1.0,
+                       coefficients_->sensor.loop.scale(dt) - 1.0);
 }
 
 AdaptedReconstruction::Scales AdaptedReconstruction::scales(const Drift& dr) const noexcept {
@@ -203,18 +209,21 @@ AdaptedReconstruction::Scales AdaptedReconstruction::scales(const Drift& dr) con
     const double dt = temperature_change(coefficients_->sensor.linear, dr.permittivity);
     const models::SideTemperature& s = coefficients_->sensor;
     const models::SideTemperature& a = coefficients_->actuator;
-    return {1.0 + dr.permittivity, 1.0 + dr.loop,     s.coupling.scale(dt),
-            a.linear.scale(dt),    a.loop.scale(dt),  a.coupling.scale(dt)};
+    return {1.0 + dr.permittivity, 1.0 + dr.loop,    s.coupling.scale(dt),
+            a.linear.scale(dt),    a.loop.scale(dt), a.coupling.scale(dt)};
   }
-  return {1.0 + dr.permittivity, 1.0 + dr.loop,   1.0 + dr.coupling,
-          1.0 + dr.coupling,     1.0 + dr.loop,   1.0 + dr.compliance};
+  return {1.0 + dr.permittivity, 1.0 + dr.loop, 1.0 + dr.coupling,
+          1.0 + dr.coupling,     1.0 + dr.loop, 1.0 + dr.compliance};
 }
 
 Drift AdaptedReconstruction::drift() const noexcept {
   Drift dr = estimator_.drift();
-  if (coefficients_ && measured_degc_ == kNoTemperature) {
-    dr.temperature_degc = coefficients_->reference_degc +
-                          temperature_change(coefficients_->sensor.linear, dr.permittivity);
+  if (coefficients_) {
+    dr.temperature_degc =
+        measured_degc_ != kNoTemperature
+            ? measured_degc_
+            : coefficients_->reference_degc +
+                  temperature_change(coefficients_->sensor.linear, dr.permittivity);
   }
   return dr;
 }

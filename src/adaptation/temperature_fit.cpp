@@ -101,7 +101,8 @@ TemperatureFitResult fit_temperature(const models::TransducerModel& model,
         "temperature fit: needs a field-driven model with a sensor and an actuator side"};
   }
   if (model.sensed_correction || model.strain_correction) {
-    throw std::invalid_argument{"temperature fit: a model with diagnosed corrections is not fitted"};
+    throw std::invalid_argument{
+        "temperature fit: a model with diagnosed corrections is not fitted"};
   }
   const std::size_t n = in.field.size();
   if (in.sensed.size() != n || in.stress.size() != n || in.strain.size() != n ||
@@ -140,9 +141,10 @@ TemperatureFitResult fit_temperature(const models::TransducerModel& model,
     const double ya = in.strain[k] - fixed_a - pa.linear - pa.loop - a.coupling() * t;
     const auto xs = columns(ps.linear, ps.loop, s.coupling() * t, dt, quadratic);
     const auto xa = columns(pa.linear, pa.loop, a.coupling() * t, dt, quadratic);
-    const bool finite = std::isfinite(ys) && std::isfinite(ya) &&
-                        std::all_of(xs.begin(), xs.end(), [](double v) { return std::isfinite(v); }) &&
-                        std::all_of(xa.begin(), xa.end(), [](double v) { return std::isfinite(v); });
+    const bool finite =
+        std::isfinite(ys) && std::isfinite(ya) &&
+        std::all_of(xs.begin(), xs.end(), [](double v) { return std::isfinite(v); }) &&
+        std::all_of(xa.begin(), xa.end(), [](double v) { return std::isfinite(v); });
     if (!finite) continue;
     sensor.add(xs, ys);
     actuator.add(xa, ya);

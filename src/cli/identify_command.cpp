@@ -111,13 +111,12 @@ void print_chosen_sizes(const models::TransducerModel& model) {
 // column spans at least 2 K; the reference is the identification recording's mean temperature
 // (or --reference-degc without one). Returns the JSON figures, or null when nothing was fitted.
 nlohmann::json fit_temperature_coefficients(models::TransducerModel& model,
-                                            const IdentifyOptions& opt,
-                                            const io::Recording& rec,
+                                            const IdentifyOptions& opt, const io::Recording& rec,
                                             const FieldSignals& signals,
                                             const std::optional<models::Geometry>& geometry) {
   const auto column = [&opt](const io::Recording& r) {
     return r.has(opt.temperature_column) ? r.column(opt.temperature_column)
-                                                : std::span<const double>{};
+                                         : std::span<const double>{};
   };
   const std::span<const double> own = column(rec);
   double reference = opt.reference_degc;
@@ -135,9 +134,8 @@ nlohmann::json fit_temperature_coefficients(models::TransducerModel& model,
   const std::span<const double> temp = other ? column(*other) : own;
   if (temp.empty()) {
     if (other) {
-      throw std::invalid_argument("--temperature-recording: " +
-                                  opt.temperature_recording.string() + " has no column '" +
-                                  opt.temperature_column + "'");
+      throw std::invalid_argument("--temperature-recording: " + opt.temperature_recording.string() +
+                                  " has no column '" + opt.temperature_column + "'");
     }
     return nullptr;
   }

@@ -18,8 +18,8 @@ bool TemperatureCoefficients::is_valid(const std::string& prefix, std::string* w
     const struct {
       const char* name;
       const TemperaturePolynomial* poly;
-    } polys[] = {{"linear", &s.side->linear}, {"loop", &s.side->loop},
-                 {"coupling", &s.side->coupling}};
+    } polys[] = {
+        {"linear", &s.side->linear}, {"loop", &s.side->loop}, {"coupling", &s.side->coupling}};
     for (const auto& p : polys) {
       const std::string key = std::string(s.name) + "." + p.name;
       if (!std::isfinite(p.poly->per_k)) return bad(key + ".per_k");

@@ -128,8 +128,10 @@ class AdaptedReconstruction final {
   // the fitted permittivity polynomial reaches the learned epsilon (header comment).
   [[nodiscard]] Drift drift() const noexcept;
   [[nodiscard]] const DriftEstimator& estimator() const noexcept { return estimator_; }
-  // A measured temperature [degC] sets the drift instead of the estimate (until the next learn);
-  // with the model's fitted temperature coefficients, the reconstruction uses them at this
+  // A measured temperature [degC] sets the drift instead of the estimate (until the next learn;
+  // with the model's coefficients epsilon and lambda are its sensor polynomials there, so the
+  // equivalent temperature reads back the measured one); with the coefficients the
+  // reconstruction uses them at this
   // temperature until the next set_temperature() or clear_temperature() (header comment). Not
   // finite: ignored.
   void set_temperature(double degc) noexcept;
