@@ -165,8 +165,9 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field,
   const double mount_now =
       -mount_kappa_ / (1.0 + mount_ratio_ * (1.0 + now.compliance)) *
       (fixed_a + (1.0 + now.coupling) * pa.linear + (1.0 + now.loop) * pa.loop);
+  const bool measured = measured_degc_ != kNoTemperature;  // learns nothing meanwhile
   estimator_.step(field, sensed - fixed_s - (1.0 + now.coupling) * s.coupling() * mount_now,
-                  ps.linear, ps.loop, accepted);
+                  ps.linear, ps.loop, accepted && !measured);
   const Drift dr = estimator_.drift();
   const Scales g = scales(dr);
   const double unloaded = fixed_s + g.sensor_linear * ps.linear + g.sensor_loop * ps.loop;
@@ -178,7 +179,7 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field,
     out.strain = fixed_a + g.actuator_linear * pa.linear + g.actuator_loop * pa.loop +
                  g.actuator_compliance * a.coupling() * out.stress;
   }
-  if (thermal_) {  // carry the estimate to the next sample's predicted temperature
+  if (thermal_ && !measured) {  // carry the estimate to the next sample's predicted temperature
     thermal_->step(field, sensed, accepted);
     estimator_.carry(thermal_->predict(dr.temperature_degc) - dr.temperature_degc);
   }

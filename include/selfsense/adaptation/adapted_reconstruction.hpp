@@ -128,14 +128,14 @@ class AdaptedReconstruction final {
   // the fitted permittivity polynomial reaches the learned epsilon (header comment).
   [[nodiscard]] Drift drift() const noexcept;
   [[nodiscard]] const DriftEstimator& estimator() const noexcept { return estimator_; }
-  // A measured temperature [degC] sets the drift instead of the estimate (until the next learn;
-  // with the model's coefficients epsilon and lambda are its sensor polynomials there, so the
-  // equivalent temperature reads back the measured one); with the coefficients the
-  // reconstruction uses them at this
-  // temperature until the next set_temperature() or clear_temperature() (header comment). Not
-  // finite: ignored.
+  // A measured temperature [degC] replaces the estimate until the next set_temperature() or
+  // clear_temperature() (header comment): the drift is set from the coefficients per K (with the
+  // model's fitted coefficients epsilon and lambda are its sensor polynomials there, and the
+  // reconstruction takes all six scales from them). Meanwhile the estimator learns nothing (its
+  // anchor drops, the thermal model does not carry it): a sensor that fails leaves the estimate
+  // at its last temperature. Not finite: ignored.
   void set_temperature(double degc) noexcept;
-  // Back to the estimated drift.
+  // Back to the estimated drift, learning from the next samples on.
   void clear_temperature() noexcept { measured_degc_ = kNoTemperature; }
   // The model carries fitted temperature coefficients.
   [[nodiscard]] bool has_temperature_coefficients() const noexcept {
