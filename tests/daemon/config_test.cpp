@@ -136,10 +136,10 @@ TEST(DaemonConfig, TheAdaptationSectionIsReadStrictlyAndValidated) {
   EXPECT_FALSE(on.config.adaptation.use_temperature);
   EXPECT_FALSE(on.config.loop_config().adaptation_temperature);
   // The driver's temperature into the adaptation: only with the adaptation on.
-  const ConfigResult temp = load_sim(
-      "adapt-temp", {{"  enabled: false                # true: the loop",
-                      "  enabled: true                 # true: the loop"},
-                     {"use_temperature: false", "use_temperature: true"}});
+  const ConfigResult temp =
+      load_sim("adapt-temp", {{"  enabled: false                # true: the loop",
+                               "  enabled: true                 # true: the loop"},
+                              {"use_temperature: false", "use_temperature: true"}});
   ASSERT_TRUE(temp.ok()) << temp.problems.front();
   EXPECT_TRUE(temp.config.adaptation.use_temperature);
   EXPECT_TRUE(temp.config.loop_config().adaptation_temperature);
