@@ -44,6 +44,30 @@ double linear_weight(const models::SideOperator& side) noexcept {
   return p.hysteresis.linear_weight * p.superposition.linear_weight;
 }
 
+// The model's fitted coefficients (first order) replace the configured ones per K: the tie of
+// the loop to the permittivity, the equivalent temperature's scale and reference.
+DriftEstimatorConfig with_coefficients(DriftEstimatorConfig config,
+                                       const models::TransducerModel& model) {
+  if (!model.temperature || model.temperature->sensor.linear.per_k == 0.0) return config;
+  const models::TemperatureCoefficients& t = *model.temperature;
+  config.reference_degc = t.reference_degc;
+  config.permittivity_per_k = t.sensor.linear.per_k;
+  config.loop_per_k = t.sensor.loop.per_k;
+  config.coupling_per_k = t.sensor.coupling.per_k;
+  config.compliance_per_k = t.actuator.coupling.per_k;
+  return config;
+}
+
+// The temperature change at which g(dtheta) = 1 + epsilon: the root nearest the first-order one
+// (the vertex where there is none).
+double temperature_change(const models::TemperaturePolynomial& g, double epsilon) noexcept {
+  if (g.per_k2 == 0.0) return g.per_k != 0.0 ? epsilon / g.per_k : 0.0;
+  const double disc = g.per_k * g.per_k + 4.0 * g.per_k2 * epsilon;
+  if (disc < 0.0) return -g.per_k / (2.0 * g.per_k2);
+  const double q = g.per_k + std::copysign(std::sqrt(disc), g.per_k);
+  return q != 0.0 ? 2.0 * epsilon / q : 0.0;
+}
+
 }  // namespace
 
 SideSplit::SideSplit(const models::SideOperator& side)
@@ -77,11 +101,13 @@ AdaptedReconstruction::AdaptedReconstruction(const models::TransducerModel& mode
                                              double range_margin, Tag /*unused*/)
     : kernel_(model),
       sensor_split_(*kernel_.sensor()),
-      estimator_(config, model.sample_time, linear_weight(*kernel_.sensor())),
+      estimator_(with_coefficients(config, model), model.sample_time,
+                 linear_weight(*kernel_.sensor())),
       gate_(model.drive_range, model.sensed_range, range_margin),
       last_{0.0, kNaN, models::SampleStatus::kOk} {
   if (kernel_.actuator()) actuator_split_.emplace(*kernel_.actuator());
   if (config.thermal.enabled) thermal_.emplace(config.thermal, model.sample_time);
+  coefficients_ = model.temperature;
   identity_ = {model.structure, models::parameter_hash(model), state_size()};
   if (!(range_margin >= 0.0)) {
     throw std::invalid_argument{"adaptation: range_margin must be >= 0"};
@@ -139,23 +165,68 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field,
   const double mount_now =
       -mount_kappa_ / (1.0 + mount_ratio_ * (1.0 + now.compliance)) *
       (fixed_a + (1.0 + now.coupling) * pa.linear + (1.0 + now.loop) * pa.loop);
+  const bool measured = measured_degc_ != kNoTemperature;  // learns nothing meanwhile
   estimator_.step(field, sensed - fixed_s - (1.0 + now.coupling) * s.coupling() * mount_now,
-                  ps.linear, ps.loop, accepted);
+                  ps.linear, ps.loop, accepted && !measured);
   const Drift dr = estimator_.drift();
-  const double unloaded = fixed_s + (1.0 + dr.permittivity) * ps.linear + (1.0 + dr.loop) * ps.loop;
-  Estimate out{(sensed - unloaded) / ((1.0 + dr.coupling) * s.coupling()), kNaN,
+  const Scales g = scales(dr);
+  const double unloaded = fixed_s + g.sensor_linear * ps.linear + g.sensor_loop * ps.loop;
+  Estimate out{(sensed - unloaded) / (g.sensor_coupling * s.coupling()), kNaN,
                models::SampleStatus::kOk,
                fixed_s + ps.linear + ps.loop + s.coupling() * mount_stress};
   if (kernel_.actuator()) {
     const models::SideOperator& a = *kernel_.actuator();
-    out.strain = fixed_a + (1.0 + dr.coupling) * pa.linear + (1.0 + dr.loop) * pa.loop +
-                 (1.0 + dr.compliance) * a.coupling() * out.stress;
+    out.strain = fixed_a + g.actuator_linear * pa.linear + g.actuator_loop * pa.loop +
+                 g.actuator_compliance * a.coupling() * out.stress;
   }
-  if (thermal_) {  // carry the estimate to the next sample's predicted temperature
+  if (thermal_ && !measured) {  // carry the estimate to the next sample's predicted temperature
     thermal_->step(field, sensed, accepted);
     estimator_.carry(thermal_->predict(dr.temperature_degc) - dr.temperature_degc);
   }
   return out;
+}
+
+void AdaptedReconstruction::set_temperature(double degc) noexcept {
+  if (!std::isfinite(degc)) return;
+  measured_degc_ = degc;
+  if (!coefficients_) {
+    estimator_.set_temperature(degc);
+    return;
+  }
+  const double dt = degc - coefficients_->reference_degc;  // the fitted sensor side's drift
+  estimator_.set_drift(coefficients_->sensor.linear.scale(dt) - 1.0,
+                       coefficients_->sensor.loop.scale(dt) - 1.0);
+}
+
+AdaptedReconstruction::Scales AdaptedReconstruction::scales(const Drift& dr) const noexcept {
+  if (coefficients_ && measured_degc_ != kNoTemperature) {
+    const double dt = measured_degc_ - coefficients_->reference_degc;
+    const models::SideTemperature& s = coefficients_->sensor;
+    const models::SideTemperature& a = coefficients_->actuator;
+    return {s.linear.scale(dt), s.loop.scale(dt), s.coupling.scale(dt),
+            a.linear.scale(dt), a.loop.scale(dt), a.coupling.scale(dt)};
+  }
+  if (coefficients_) {  // the learned sensor side; the rest at the equivalent temperature
+    const double dt = temperature_change(coefficients_->sensor.linear, dr.permittivity);
+    const models::SideTemperature& s = coefficients_->sensor;
+    const models::SideTemperature& a = coefficients_->actuator;
+    return {1.0 + dr.permittivity, 1.0 + dr.loop,    s.coupling.scale(dt),
+            a.linear.scale(dt),    a.loop.scale(dt), a.coupling.scale(dt)};
+  }
+  return {1.0 + dr.permittivity, 1.0 + dr.loop, 1.0 + dr.coupling,
+          1.0 + dr.coupling,     1.0 + dr.loop, 1.0 + dr.compliance};
+}
+
+Drift AdaptedReconstruction::drift() const noexcept {
+  Drift dr = estimator_.drift();
+  if (coefficients_) {
+    dr.temperature_degc =
+        measured_degc_ != kNoTemperature
+            ? measured_degc_
+            : coefficients_->reference_degc +
+                  temperature_change(coefficients_->sensor.linear, dr.permittivity);
+  }
+  return dr;
 }
 
 std::size_t AdaptedReconstruction::state_size() const noexcept {

@@ -130,10 +130,15 @@ Drift DriftEstimator::drift() const noexcept {
 
 void DriftEstimator::set_temperature(double degc) noexcept {
   if (!std::isfinite(degc)) return;
-  const double bound = config_.max_relative_change;
   const double rise = degc - config_.reference_degc;
-  theta_[0] = std::clamp(config_.permittivity_per_k * rise, -bound, bound);
-  theta_[1] = std::clamp(config_.loop_per_k * rise, -bound, bound);
+  set_drift(config_.permittivity_per_k * rise, config_.loop_per_k * rise);
+}
+
+void DriftEstimator::set_drift(double permittivity, double loop) noexcept {
+  if (!std::isfinite(permittivity) || !std::isfinite(loop)) return;
+  const double bound = config_.max_relative_change;
+  theta_[0] = std::clamp(permittivity, -bound, bound);
+  theta_[1] = std::clamp(loop, -bound, bound);
 }
 
 void DriftEstimator::carry(double delta_k) noexcept {

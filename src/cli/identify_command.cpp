@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "selfsense/adaptation/temperature_fit.hpp"
 #include "selfsense/evaluation/field_signals.hpp"
 #include "selfsense/evaluation/model_runs.hpp"
 #include "selfsense/evaluation/work_runner.hpp"
@@ -53,6 +54,11 @@ struct IdentifyOptions {
   int bias_levels{-1};
   double fastest{0.0};
   double slowest{0.0};
+  // Temperature coefficients (docs/adaptation.md): fitted on this recording (a ramp with a temp
+  // column), or on --recording itself when its temp column spans at least 2 K.
+  std::filesystem::path temperature_recording{};
+  std::string temperature_column{"temp"};
+  double reference_degc{25.0};  // used when --recording has no temperature column
 };
 
 void print_table(const std::vector<ChannelFigures>& fit, const std::vector<ChannelFigures>& held) {
@@ -84,6 +90,81 @@ void print_chosen_sizes(const models::TransducerModel& model) {
   std::printf("sizes chosen on the fitting data:\n");
   describe("sensor", model.sensor);
   describe("actuator", model.actuator);
+}
+
+// The temperature coefficients (adaptation/temperature_fit.hpp) on the recording that has the
+// temperature: --temperature-recording, or the identification recording when its temperature
+// column spans at least 2 K; the reference is the identification recording's mean temperature
+// (or --reference-degc without one). Returns the JSON figures, or null when nothing was fitted.
+nlohmann::json fit_temperature_coefficients(models::TransducerModel& model,
+                                            const IdentifyOptions& opt, const io::Recording& rec,
+                                            const FieldSignals& signals,
+                                            const std::optional<models::Geometry>& geometry) {
+  const auto column = [&opt](const io::Recording& r) {
+    return r.has(opt.temperature_column) ? r.column(opt.temperature_column)
+                                         : std::span<const double>{};
+  };
+  const std::span<const double> own = column(rec);
+  double reference = opt.reference_degc;
+  if (!own.empty()) {
+    double sum = 0.0;
+    for (const double v : own)
+      sum += v;
+    reference = sum / static_cast<double>(own.size());
+  }
+  std::optional<io::Recording> other;
+  if (!opt.temperature_recording.empty()) {
+    other = io::read_recording_csv(opt.temperature_recording, io::ReadOptions{{"t"}});
+  }
+  const io::Recording& source = other ? *other : rec;
+  const std::span<const double> temp = other ? column(*other) : own;
+  if (temp.empty()) {
+    if (other) {
+      throw std::invalid_argument("--temperature-recording: " + opt.temperature_recording.string() +
+                                  " has no column '" + opt.temperature_column + "'");
+    }
+    return nullptr;
+  }
+  const auto [lo, hi] = std::minmax_element(temp.begin(), temp.end());
+  if (!other && *hi - *lo < 2.0) return nullptr;  // one temperature: nothing to fit
+  if (!model.sensor || !model.actuator || model.drive() != models::Drive::kField ||
+      model.vectorial) {
+    if (other) {
+      throw std::invalid_argument(
+          "--temperature-recording: the temperature coefficients need a field-driven structure "
+          "with both sides");
+    }
+    std::printf("note: temperature column ignored: this structure has no coefficients per K\n");
+    return nullptr;
+  }
+  const std::string name = other ? opt.temperature_recording.string() : opt.recording.string();
+  const FieldSignals fs =
+      other ? field_signals(source, name, geometry, models::Drive::kField) : signals;
+  if (fs.stress.empty() || fs.s.empty() || fs.e.empty() || fs.d.empty()) {
+    throw std::invalid_argument("temperature coefficients: " + name + " needs E, D, S and T");
+  }
+  const adaptation::TemperatureFitResult fit =
+      adaptation::fit_temperature(model, {fs.e, fs.d, fs.stress, fs.s, temp}, reference);
+  model.temperature = fit.coefficients;
+  const models::SideTemperature& se = fit.coefficients.sensor;
+  const models::SideTemperature& ac = fit.coefficients.actuator;
+  std::printf(
+      "temperature coefficients from %s (%.1f .. %.1f degC, reference %.2f degC), per K and "
+      "per K^2:\n"
+      "  sensor   permittivity %+.3e %+.3e, loop %+.3e %+.3e, coupling   %+.3e %+.3e\n"
+      "  actuator linear       %+.3e %+.3e, loop %+.3e %+.3e, compliance %+.3e %+.3e\n"
+      "  residual RMS: D %.3g -> %.3g C/m^2, S %.3g -> %.3g\n",
+      name.c_str(), *lo, *hi, reference, se.linear.per_k, se.linear.per_k2, se.loop.per_k,
+      se.loop.per_k2, se.coupling.per_k, se.coupling.per_k2, ac.linear.per_k, ac.linear.per_k2,
+      ac.loop.per_k, ac.loop.per_k2, ac.coupling.per_k, ac.coupling.per_k2, fit.sensor_rms_before,
+      fit.sensor_rms_after, fit.actuator_rms_before, fit.actuator_rms_after);
+  return {{"recording", name},
+          {"reference_degc", reference},
+          {"samples", fit.samples},
+          {"sensed_rms_before", fit.sensor_rms_before},
+          {"sensed_rms_after", fit.sensor_rms_after},
+          {"strain_rms_before", fit.actuator_rms_before},
+          {"strain_rms_after", fit.actuator_rms_after}};
 }
 
 void run_identify(const IdentifyOptions& opt) {
@@ -180,6 +261,9 @@ void run_identify(const IdentifyOptions& opt) {
   if (model.actuator && !model.actuator->linear_gains.empty()) {
     report["actuator_coupling"] = model.actuator->linear_gains.front();
   }
+  const nlohmann::json temperature =
+      fit_temperature_coefficients(model, opt, rec, signals, geometry);
+  if (!temperature.is_null()) report["temperature"] = temperature;
   models::save_model(model, opt.out,
                      "{fit: " + to_json(fit).dump() + ", held_out: " + to_json(held).dump() + "}");
   std::printf("wrote %s\n", opt.out.string().c_str());
@@ -244,6 +328,14 @@ void add_identify_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--slowest-eigenvalue", opt->slowest, "Slowest creep eigenvalue [1/s]")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--temperature-recording", opt->temperature_recording,
+                  "A recording with a temperature column (a ramp) to fit the temperature "
+                  "coefficients on (default: --recording, when its temperature varies by 2 K)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--temperature-column", opt->temperature_column,
+                  "The temperature column [degC] (default temp)");
+  cmd->add_option("--reference-degc", opt->reference_degc,
+                  "The identification temperature when --recording has no temperature column");
   cmd->callback([opt] { run_identify(*opt); });
 }
 

@@ -207,6 +207,7 @@ void read_adaptation(YamlMap a, AdaptationSection& out) {
   a.read("ambient_degc", e.thermal.ambient_degc);
   a.read("stack_volume_m3", e.thermal.stack_volume_m3);
   a.read("max_power_w", e.thermal.max_power_w);
+  a.read("use_temperature", out.use_temperature);
   a.finish();
 }
 
@@ -346,6 +347,7 @@ runtime::LoopConfig DaemonConfig::loop_config() const {
   l.overrun = safety.overrun;
   l.watchdog_s = safety.watchdog_s;
   l.status_period = loop.status_period_cycles;
+  l.adaptation_temperature = adaptation.enabled && adaptation.use_temperature;
   l.health_enabled = health.enabled;
   l.health = health.estimator;
   l.health_bands = health.bands;

@@ -125,6 +125,7 @@ const std::array kTable{
     // The learned drift is relative to the running model and read with these coefficients;
     // `ctl adapt freeze|resume` freezes and resumes at run time.
     ReloadKey{"adaptation.enabled", kRefused, differs<&C::adaptation, &A::enabled>},
+    ReloadKey{"adaptation.use_temperature", kRefused, differs<&C::adaptation, &A::use_temperature>},
     ReloadKey{"adaptation.frozen", kRefused, differs<&C::adaptation, &A::estimator, &E::frozen>},
     ReloadKey{"adaptation.learn_loop", kRefused,
               differs<&C::adaptation, &A::estimator, &E::learn_loop>},

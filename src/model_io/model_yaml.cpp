@@ -191,6 +191,29 @@ std::optional<ChannelCorrection> read_correction(YamlMap& corrections, std::stri
   return c;
 }
 
+// temperature: {reference_degc, sensor: {linear: [per_k, per_k2], loop: [...], coupling: [...]},
+//               actuator: {...}}
+TemperatureCoefficients read_temperature(YamlMap& m) {
+  TemperatureCoefficients t;
+  t.reference_degc = m.required<double>("reference_degc");
+  const auto side = [&m](std::string_view key, SideTemperature& out) {
+    YamlMap s = m.map(key);
+    const std::pair<const char*, TemperaturePolynomial*> polys[] = {
+        {"linear", &out.linear}, {"loop", &out.loop}, {"coupling", &out.coupling}};
+    for (const auto& [name, poly] : polys) {
+      std::vector<double> v;
+      s.read_sequence(name, v);
+      if (v.size() != 2) s.fail(name, "expected [per_k, per_k2] (two numbers)");
+      *poly = {v[0], v[1]};
+    }
+    s.finish();
+  };
+  side("sensor", t.sensor);
+  side("actuator", t.actuator);
+  m.finish();
+  return t;
+}
+
 TransducerModel read_model(YamlMap root) {
   const int version = root.required<int>("selfsense_model");
   if (version < kOldestModelFormatVersion || version > kModelFormatVersion) {
@@ -242,6 +265,12 @@ TransducerModel read_model(YamlMap root) {
     model.strain_correction = read_correction(*c, "strain");
     c->finish();
   }
+  if (auto t = root.optional_map("temperature")) {
+    if (model.drive() != Drive::kField || !model.sensor || !model.actuator) {
+      root.fail("temperature", "needs a field-driven model with both sides");
+    }
+    model.temperature = read_temperature(*t);
+  }
   if (root.has("fit")) static_cast<void>(root.optional_map("fit"));  // notes only
   root.finish();
   std::string why;
@@ -254,6 +283,21 @@ void emit_sequence(YAML::Emitter& out, const char* key, const std::vector<double
   for (const double v : values)
     out << v;
   out << YAML::EndSeq;
+}
+
+void emit_temperature(YAML::Emitter& out, const TemperatureCoefficients& t) {
+  out << YAML::Key << "temperature" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "reference_degc" << YAML::Value << t.reference_degc;
+  const std::pair<const char*, const SideTemperature*> sides[] = {{"sensor", &t.sensor},
+                                                                  {"actuator", &t.actuator}};
+  for (const auto& [name, side] : sides) {
+    out << YAML::Key << name << YAML::Value << YAML::BeginMap;
+    emit_sequence(out, "linear", {side->linear.per_k, side->linear.per_k2});
+    emit_sequence(out, "loop", {side->loop.per_k, side->loop.per_k2});
+    emit_sequence(out, "coupling", {side->coupling.per_k, side->coupling.per_k2});
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
 }
 
 void emit_side(YAML::Emitter& out, const char* key, const SideModel& side) {
@@ -391,6 +435,7 @@ std::string model_to_string(const TransducerModel& model, const std::string& fit
     if (model.strain_correction) emit_correction(out, "strain", *model.strain_correction);
     out << YAML::EndMap;
   }
+  if (model.temperature) emit_temperature(out, *model.temperature);
   if (!fit_notes.empty()) out << YAML::Key << "fit" << YAML::Value << YAML::Load(fit_notes);
   out << YAML::Key << "complete" << YAML::Value << true;  // last: the file is whole
   out << YAML::EndMap;

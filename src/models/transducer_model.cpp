@@ -81,6 +81,7 @@ bool TransducerModel::is_valid(std::string* why) const {
   if (!operators::check::positive("sample_time", sample_time, why)) return false;
   if (sensed_correction && !sensed_correction->is_valid("corrections.sensed", why)) return false;
   if (strain_correction && !strain_correction->is_valid("corrections.strain", why)) return false;
+  if (temperature && !temperature->is_valid("temperature.", why)) return false;
   if (!range_valid("input_range.drive", drive_range, why) ||
       !range_valid("input_range.sensed", sensed_range, why)) {
     return false;

@@ -328,6 +328,13 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
   sample.t_ref = in.t_ref;
   sample.temp_ref = in.temp_ref;
   sample.driver_status = in.device_status;
+  if (adapted_ && config_.adaptation_temperature) {
+    if (read == DriverStatus::kOk && std::isfinite(in.temp_ref)) {
+      adapted_->set_temperature(in.temp_ref);
+    } else {
+      adapted_->clear_temperature();
+    }
+  }
   if (read == DriverStatus::kOk) {
     const models::Reconstruction::Estimate est = estimate(in.e, in.d);
     sample.estimate_status = static_cast<std::uint8_t>(est.status);

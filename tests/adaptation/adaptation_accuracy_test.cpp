@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
+#include "selfsense/adaptation/temperature_fit.hpp"
 #include "selfsense/identification/fit_quality.hpp"
 #include "selfsense/identification/transducer_fit.hpp"
 #include "selfsense/models/reconstructor.hpp"
@@ -54,6 +55,43 @@ const models::TransducerModel& main_job_model() {
     return identification::identify(
         {r.e, r.d, r.t, r.s, 1.0 / f.plant.sample_rate_hz}, models::Structure::kPreisachCreep,
         identification::defaults_for(models::Structure::kPreisachCreep));
+  }();
+  return model;
+}
+
+// The main job's model with temperature coefficients fitted on a ramp recording (issue 24 items 1
+// and 5): the identification plant and excitation (config/plant/reconstruction.yaml, seed 2:
+// other noise than the model's recording) with config/plant/temperature.yaml's coefficients,
+// warming 25 -> 55 degC. The validation recordings' excitation (mix) is never seen.
+const models::TransducerModel& model_with_coefficients() {
+  static const models::TransducerModel model = [] {
+    plant::PlantFile f =
+        plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction.yaml");
+    f.plant.temperature =
+        plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/temperature.yaml")
+            .plant.temperature;
+    f.plant.seed = 2;
+    plant::Excitation ex =
+        plant::make_excitation("identification", f.excitation, f.plant.sample_rate_hz, 2);
+    f.excitation.temperature = {25.0, 55.0};
+    plant::apply_load_and_temperature(f.excitation, f.plant.sample_rate_hz, ex);
+    const Recorded r = record(f.plant, ex);
+    models::TransducerModel m = main_job_model();
+    const adaptation::TemperatureFitResult fit =
+        adaptation::fit_temperature(m, {r.e, r.d, r.t, r.s, r.temp}, 25.0);
+    const models::SideTemperature& s = fit.coefficients.sensor;
+    const models::SideTemperature& a = fit.coefficients.actuator;
+    std::printf(
+        "fitted on %zu samples (%.0f s): sensor L %+.3e %+.3e, H %+.3e %+.3e, d %+.3e %+.3e; "
+        "actuator L %+.3e %+.3e, H %+.3e %+.3e, s %+.3e %+.3e; residual RMS sensor %.3g -> "
+        "%.3g C/m^2, actuator %.3g -> %.3g\n",
+        fit.samples, static_cast<double>(r.e.size()) / f.plant.sample_rate_hz, s.linear.per_k,
+        s.linear.per_k2, s.loop.per_k, s.loop.per_k2, s.coupling.per_k, s.coupling.per_k2,
+        a.linear.per_k, a.linear.per_k2, a.loop.per_k, a.loop.per_k2, a.coupling.per_k,
+        a.coupling.per_k2, fit.sensor_rms_before, fit.sensor_rms_after, fit.actuator_rms_before,
+        fit.actuator_rms_after);
+    m.temperature = fit.coefficients;
+    return m;
   }();
   return model;
 }
@@ -102,9 +140,11 @@ struct Figures {
   double temperature_max_k{0.0};
 };
 
-// kind: 0 the model as identified, 1 adapted from E and D, 2 the recorded temperature.
+// kind: 0 the model as identified, 1 adapted from E and D, 2 the recorded temperature, 3 the
+// recorded temperature with the fitted coefficients (model_with_coefficients), 4 adapted from E
+// and D with the fitted coefficients.
 Figures reconstruct(const Recorded& r, int kind, std::size_t settle) {
-  const models::TransducerModel& model = main_job_model();
+  const models::TransducerModel& model = kind >= 3 ? model_with_coefficients() : main_job_model();
   std::vector<double> s_hat(r.e.size());
   std::vector<double> t_hat(r.e.size());
   double sq = 0.0;
@@ -118,10 +158,10 @@ Figures reconstruct(const Recorded& r, int kind, std::size_t settle) {
     }
   } else {
     adaptation::DriftEstimatorConfig config{};
-    config.frozen = kind == 2;
+    config.frozen = kind == 2 || kind == 3;
     adaptation::AdaptedReconstruction rec(model, config);
     for (std::size_t k = 0; k < r.e.size(); ++k) {
-      if (kind == 2) rec.set_temperature(r.temp[k]);
+      if (kind == 2 || kind == 3) rec.set_temperature(r.temp[k]);
       const auto est = rec.step(r.e[k], r.d[k]);
       s_hat[k] = est.strain;
       t_hat[k] = est.stress;
@@ -151,13 +191,16 @@ void print(const char* what, const Figures& f) {
 //                         equivalent temperature 2.66 K RMS, 5.72 K max after the first 20 s
 //   recorded temperature  S_hat 0.165 % (max 0.63 %), T_hat 0.709 % (max 2.50 %)
 // Issue 24's goal (0.2 % and 0.8 % without the temperature, 0.15 % and 0.6 % with it, 2 K) is
-// not reached: the bounds below are the measured figures with a margin of about 1.3x.
+// not reached with the model alone: the bounds below are the measured figures with a margin of
+// about 1.3x. With the fitted temperature coefficients, at the end of the test.
 TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
   const Recorded r = warming_recording(21, 25.0, 55.0, 2);
   const std::size_t settle = 20000;  // 20 s at 1 kHz before the temperature error is counted
   const Figures none = reconstruct(r, 0, settle);
   const Figures adapted = reconstruct(r, 1, settle);
   const Figures measured = reconstruct(r, 2, settle);
+  const Figures fitted = reconstruct(r, 3, settle);
+  const Figures adapted_fitted = reconstruct(r, 4, settle);
   print("as identified", none);
   print("adapted (E, D only)", adapted);
   print("recorded temperature", measured);
@@ -178,6 +221,24 @@ TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
   EXPECT_GE(none.stress.nrmse, 0.045);
   EXPECT_LT(adapted.strain.nrmse, 0.25 * none.strain.nrmse);
   EXPECT_LT(adapted.stress.nrmse, 0.25 * none.stress.nrmse);
+  // With the temperature coefficients fitted on the identification excitation's ramp
+  // (model_with_coefficients), measured 0.152 % (max 0.57 %) and 0.591 % (max 2.19 %) with the
+  // recorded temperature; 0.208 % (max 0.90 %), 0.690 % (max 2.81 %), 2.39 K RMS, 5.50 K max
+  // adapted from E and D.
+  print("recorded, fitted coef", fitted);
+  print("adapted, fitted coef", adapted_fitted);
+  EXPECT_LE(fitted.strain.nrmse, 0.0020);
+  EXPECT_LE(fitted.strain.max, 0.0074);
+  EXPECT_LE(fitted.stress.nrmse, 0.0077);
+  EXPECT_LE(fitted.stress.max, 0.0285);
+  EXPECT_LT(fitted.stress.nrmse, measured.stress.nrmse);
+  EXPECT_LE(adapted_fitted.strain.nrmse, 0.0027);
+  EXPECT_LE(adapted_fitted.strain.max, 0.0117);
+  EXPECT_LE(adapted_fitted.stress.nrmse, 0.0090);
+  EXPECT_LE(adapted_fitted.stress.max, 0.0365);
+  EXPECT_LE(adapted_fitted.temperature_rms_k, 3.1);
+  EXPECT_LE(adapted_fitted.temperature_max_k, 7.2);
+  EXPECT_LT(adapted_fitted.stress.nrmse, adapted.stress.nrmse);
 }
 
 // Slow random swings about 40 degC (between about 26 and 54 degC, up to 0.5 K/s), the same
@@ -193,9 +254,13 @@ TEST(AdaptationAccuracy, SlowRandomSwingsWithoutTemperatureInput) {
   const Figures none = reconstruct(r, 0, settle);
   const Figures adapted = reconstruct(r, 1, settle);
   const Figures measured = reconstruct(r, 2, settle);
+  const Figures fitted = reconstruct(r, 3, settle);
+  const Figures adapted_fitted = reconstruct(r, 4, settle);
   print("swings, as identified", none);
   print("swings, adapted", adapted);
   print("swings, recorded temp", measured);
+  print("swings, fitted coef", fitted);
+  print("swings, adapted fitted", adapted_fitted);
   EXPECT_LE(adapted.strain.nrmse, 0.0053);
   EXPECT_LE(adapted.stress.nrmse, 0.018);
   EXPECT_LE(adapted.temperature_rms_k, 5.0);
@@ -204,6 +269,13 @@ TEST(AdaptationAccuracy, SlowRandomSwingsWithoutTemperatureInput) {
   EXPECT_GE(none.stress.nrmse, 0.04);
   EXPECT_LT(adapted.strain.nrmse, 0.35 * none.strain.nrmse);
   EXPECT_LT(adapted.stress.nrmse, 0.35 * none.stress.nrmse);
+  // With the fitted coefficients, measured 0.123 % and 0.499 % with the recorded temperature;
+  // 0.341 %, 1.090 %, 3.71 K RMS adapted from E and D.
+  EXPECT_LE(fitted.strain.nrmse, 0.0016);
+  EXPECT_LE(fitted.stress.nrmse, 0.0065);
+  EXPECT_LE(adapted_fitted.strain.nrmse, 0.0044);
+  EXPECT_LE(adapted_fitted.stress.nrmse, 0.0142);
+  EXPECT_LE(adapted_fitted.temperature_rms_k, 4.8);
 }
 
 // A 10-minute hold after the ramp (the field held at 1 MV/m, the load still moving, 55 degC):

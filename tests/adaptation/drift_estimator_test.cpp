@@ -128,6 +128,27 @@ TEST(AdaptedReconstruction, LearnsTheLoopApartWhenAskedTo) {
   EXPECT_LT(f.err_adapted, 0.1 * f.err_plain);
 }
 
+// A measured temperature replaces the estimate and the estimator learns nothing meanwhile (the
+// daemon's adaptation.use_temperature); cleared, it learns on from there and finds the rise.
+TEST(AdaptedReconstruction, LearnsNothingWhileAMeasuredTemperatureHolds) {
+  const Drifted data = drifted(0.08, -0.08, 0.04, 200000, 3);
+  AdaptedReconstruction rec(data.model, DriftEstimatorConfig{});
+  const std::size_t half = data.e.size() / 2;
+  for (std::size_t k = 0; k < half; ++k) {
+    rec.set_temperature(30.0);
+    static_cast<void>(rec.step(data.e[k], data.d[k]));
+  }
+  EXPECT_EQ(rec.estimator().updates(), 0U);
+  EXPECT_DOUBLE_EQ(rec.drift().temperature_degc, 30.0);
+  rec.set_temperature(std::nan(""));  // ignored: still 30 degC
+  EXPECT_DOUBLE_EQ(rec.drift().temperature_degc, 30.0);
+  rec.clear_temperature();
+  for (std::size_t k = half; k < data.e.size(); ++k)
+    static_cast<void>(rec.step(data.e[k], data.d[k]));
+  EXPECT_GT(rec.estimator().updates(), 1000U);
+  EXPECT_NEAR(rec.drift().temperature_degc, 45.0, 0.5);
+}
+
 TEST(DriftEstimator, LearnsNothingOnHoldsRejectedSamplesOrWhenFrozen) {
   DriftEstimator est(DriftEstimatorConfig{}, kTs, 2e-8);
   // A hold: the field within noise of one value.

@@ -31,6 +31,26 @@ tail -n 1 "$work/m.yaml" | grep -qx 'complete: true' || fail "model file does no
 held_s=$(sed -n 's/^  S  *[0-9.]* % *[0-9.]* % *\([0-9.]*\) %.*/\1/p' "$work/identify.txt")
 awk -v v="$held_s" 'BEGIN { exit !(v != "" && v < 2.0) }' || fail "held-out S nrmse '$held_s' %"
 
+# Temperature coefficients (docs/adaptation.md): the same plant warming 25 -> 55 degC (its
+# permittivity +0.4 %/K) writes a temp column; identify fits the coefficients on it, stores them
+# in the model and the JSON; reconstruct uses them with the recorded temperature.
+{ sed '/^excitation:/,$d' "$work/plant.yaml"
+  printf '  temperature: {enabled: true, reference_degc: 25.0, permittivity_coefficient_per_k: 4.0e-3}\n'
+  sed -n '/^excitation:/,$p' "$work/plant.yaml"
+  printf '  temperature: {start_degc: 25.0, end_degc: 55.0}\n'; } >"$work/warm.yaml"
+"$bin" plant --config "$work/warm.yaml" --excitation decaying --seed 2 --out "$work/rw.csv" >/dev/null
+has_column "$work/rw.csv" temp || fail "the warming plant wrote no temp column"
+"$bin" identify --recording "$work/r.csv" --structure hysteresis-creep --out "$work/mt.yaml" \
+  --json "$work/mt.json" --plays 12 --eigenvalues 3 --temperature-recording "$work/rw.csv" \
+  >"$work/identify-temp.txt"
+grep -q '^temperature:' "$work/mt.yaml" || fail "identify stored no temperature coefficients"
+grep -q '"temperature"' "$work/mt.json" || fail "identify JSON has no temperature figures"
+per_k=$(sed -n 's/^  sensor   permittivity \([-+0-9.e]*\) .*/\1/p' "$work/identify-temp.txt")
+awk -v v="$per_k" 'BEGIN { exit !(v != "" && v + 0 > 2e-3 && v + 0 < 6e-3) }' ||
+  fail "fitted permittivity per K '$per_k' (the plant's 4e-3)"
+"$bin" reconstruct --model "$work/mt.yaml" --recording "$work/rw.csv" --adapt \
+  --temperature-column temp --out "$work/rt.csv" >/dev/null || fail "reconstruct with coefficients"
+
 "$bin" simulate --model "$work/m.yaml" --recording "$work/r.csv" --out "$work/sim.csv" >/dev/null
 has_column "$work/sim.csv" D_model || fail "simulate wrote no D_model"
 has_column "$work/sim.csv" S_model || fail "simulate wrote no S_model"

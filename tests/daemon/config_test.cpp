@@ -133,6 +133,23 @@ TEST(DaemonConfig, TheAdaptationSectionIsReadStrictlyAndValidated) {
   EXPECT_TRUE(on.config.adaptation.enabled);
   EXPECT_TRUE(on.config.adaptation.estimator.frozen);
   EXPECT_EQ(on.config.adaptation.estimator.memory_updates, 800.0);
+  EXPECT_FALSE(on.config.adaptation.use_temperature);
+  EXPECT_FALSE(on.config.loop_config().adaptation_temperature);
+  // The driver's temperature into the adaptation: only with the adaptation on.
+  const ConfigResult temp =
+      load_sim("adapt-temp", {{"  enabled: false                # true: the loop",
+                               "  enabled: true                 # true: the loop"},
+                              {"use_temperature: false", "use_temperature: true"}});
+  ASSERT_TRUE(temp.ok()) << temp.problems.front();
+  EXPECT_TRUE(temp.config.adaptation.use_temperature);
+  EXPECT_TRUE(temp.config.loop_config().adaptation_temperature);
+  const ConfigResult temp_off =
+      load_sim("adapt-temp-off", {{"use_temperature: false", "use_temperature: true"}});
+  ASSERT_TRUE(temp_off.ok()) << temp_off.problems.front();
+  EXPECT_FALSE(temp_off.config.loop_config().adaptation_temperature);
+  const ConfigResult temp_bad =
+      load_sim("adapt-temp-bad", {{"use_temperature: false", "use_temperature: 3"}});
+  EXPECT_TRUE(has(temp_bad, "adaptation.use_temperature")) << temp_bad.problems.front();
 
   const ConfigResult bad = load_sim("adapt-bad", {{"memory_updates: 500", "memory_updates: 1"}});
   EXPECT_TRUE(has(bad, ".test-adapt-bad.yaml:")) << bad.problems.front();

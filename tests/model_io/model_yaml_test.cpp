@@ -109,6 +109,31 @@ TEST(ModelYaml, VectorialModelWithCreepRoundTrips) {
   expect_error(broken, "vectorial.creep.rows");
 }
 
+// The temperature coefficients (models/temperature_coefficients.hpp) come back bit-identical
+// and do not change the parameter hash; a polynomial that is not two numbers, a missing side
+// and a model with one side are refused by key.
+TEST(ModelYaml, TemperatureCoefficientsRoundTripAndAreCheckedByKey) {
+  TransducerModel m = test::typical_transducer(1e-4);
+  TemperatureCoefficients t;
+  t.reference_degc = 25.5;
+  t.sensor = {{3.9e-3, -1.25e-6}, {-4.1e-3, 2.0e-6}, {2.1e-3, 0.0}};
+  t.actuator = {{2.0e-3, 1.0e-7}, {-3.9e-3, 0.0}, {5.2e-4, -3.0e-9}};
+  m.temperature = t;
+  const std::string text = model_to_string(m);
+  const TransducerModel back = model_from_string(text);
+  ASSERT_TRUE(back.temperature.has_value());
+  EXPECT_EQ(*back.temperature, t);
+  EXPECT_EQ(model_to_string(back), text);
+  EXPECT_DOUBLE_EQ(t.sensor.linear.scale(10.0), 1.0 + 3.9e-2 - 1.25e-4);
+  std::string pair = text;
+  pair.replace(pair.find("loop: [-0.0041"), 14, "loop: [-0.0041, 1");
+  expect_error(pair, "temperature.sensor.loop: expected [per_k, per_k2]");
+  std::string side = text;
+  side.replace(side.find("  actuator:\n    linear"), 11, "  actuatorx:");
+  expect_error(side, "temperature");
+  expect_error(kMinimal + "temperature:\n  reference_degc: 25\n", "temperature: needs a field");
+}
+
 TEST(ModelYaml, MinimalModelLoads) {
   const TransducerModel m = model_from_string(kMinimal);
   EXPECT_FALSE(m.actuator.has_value());

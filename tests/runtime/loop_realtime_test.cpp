@@ -36,7 +36,8 @@ class CountingSink final : public SampleSink {
 };
 
 void every_mode_without_allocating(const models::TransducerModel& model, bool adapt = false,
-                                   bool health = false, bool thermal = false) {
+                                   bool health = false, bool thermal = false,
+                                   bool temperature = false) {
   constexpr double kTs = 1e-4;
   adaptation::DriftEstimatorConfig adapt_config{};
   adapt_config.thermal.enabled = thermal;  // the thermal model carries the estimate (on holds)
@@ -47,6 +48,7 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
   pc.mechanics.enabled = true;
   pc.mechanics.load_stiffness_n_per_m = 15e6;
   pc.mechanics.resonance_hz = 500.0;
+  pc.temperature.enabled = temperature;  // the driver fills temp_ref (the plant's reference)
   drivers::SimulatedTransducer driver(pc);
   std::string why;
   ASSERT_TRUE(driver.configure({kTs}, &why)) << why;
@@ -61,6 +63,7 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
   lc.stress_max = 1e9;
   lc.strain_min = -1.0;
   lc.strain_max = 1.0;
+  lc.adaptation_temperature = temperature;
   if (health) {  // bands so narrow that alarms latch (as warnings) and resets clear them
     lc.health_enabled = true;
     lc.health.baseline_cycles = 2;
@@ -185,9 +188,17 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
   if (adapt) {
     EXPECT_EQ(adapts_done, 1);
     EXPECT_FALSE(a.frozen);
+    EXPECT_TRUE(std::isfinite(a.temperature_degc));
+  }
+  if (adapt && !temperature) {
     EXPECT_GT(a.updates, frozen_updates);
     EXPECT_GT(frozen_updates, 50U);
-    EXPECT_TRUE(std::isfinite(a.temperature_degc));
+  }
+  if (temperature) {  // the measured temperature replaced the estimate: nothing learned
+    EXPECT_EQ(a.updates, 0U);
+    const LoopSample& last = loop.local_status().last;
+    ASSERT_TRUE(std::isfinite(last.temp_ref));
+    EXPECT_EQ(last.temp_equivalent, last.temp_ref);
   }
   const HealthStatus& h = loop.local_status().health;
   EXPECT_EQ(h.enabled, health);
@@ -227,6 +238,17 @@ TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithAdaptationAndTheShippedPrei
 
 TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithAdaptationAndTheThermalModel) {
   every_mode_without_allocating(test::typical_transducer(1e-3), true, false, true);
+}
+
+// The driver's temperature fed to the adapted reconstruction with the model's fitted temperature
+// coefficients (adaptation.use_temperature).
+TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithAdaptationAndTheMeasuredTemperature) {
+  models::TransducerModel model = test::typical_transducer(1e-3);
+  models::TemperatureCoefficients t;
+  t.sensor = {{4e-3, -1e-6}, {-3e-3, 0.0}, {2e-3, 0.0}};
+  t.actuator = {{2e-3, 0.0}, {-3e-3, 0.0}, {5e-4, 0.0}};
+  model.temperature = t;
+  every_mode_without_allocating(model, true, false, false, true);
 }
 
 TEST(LoopRealTime, CyclesInEveryModeDoNotAllocateWithHealth) {

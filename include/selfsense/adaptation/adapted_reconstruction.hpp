@@ -28,6 +28,20 @@
 // error comes from".) r = 0: the stress is taken as independent of the field
 // (docs/adaptation.md).
 //
+// A measured temperature (set_temperature) replaces the estimate: the drift is read from the
+// estimator's coefficients per K at that temperature; and when the model carries fitted
+// temperature coefficients (model.temperature, models/temperature_coefficients.hpp,
+// temperature_fit.hpp) the six scales come from them instead, per side, at dtheta = temp -
+// reference:
+//   T_hat = (D - y0_s - q_s E^2 - gL_s L_s - gH_s H_s) / (gc_s d_s)
+//   S_hat = y0_a + q_a E^2 + gL_a L_a + gH_a H_a + gc_a s_a T_hat
+// with g(dtheta) = 1 + per_k dtheta + per_k2 dtheta^2 of each part. Without a measured
+// temperature the model's coefficients serve the estimate: their first-order terms replace the
+// configured ones per K (the loop's tie, the equivalent temperature; reference_degc too), the
+// sensor side keeps the learned (1 + epsilon) and (1 + lambda), and the coupling and the
+// actuator's three scales are the polynomials at the equivalent temperature dtheta_eq, the root
+// of g_L,s(dtheta) = 1 + epsilon nearest epsilon / per_k.
+//
 // With the thermal model on (config.thermal.enabled, thermal_model.hpp), after each sample the
 // estimate is carried to the temperature the thermal law predicts for the next one, from the
 // power of the measured E and D (a rejected sample brings none) and the present equivalent
@@ -110,10 +124,23 @@ class AdaptedReconstruction final {
   // drops its anchor, so no increment spans the gap.
   void skip() noexcept { estimator_.drop_anchor(); }
 
-  [[nodiscard]] Drift drift() const noexcept { return estimator_.drift(); }
+  // The estimator's drift; with the model's coefficients, the equivalent temperature is where
+  // the fitted permittivity polynomial reaches the learned epsilon (header comment).
+  [[nodiscard]] Drift drift() const noexcept;
   [[nodiscard]] const DriftEstimator& estimator() const noexcept { return estimator_; }
-  // A measured temperature [degC] sets the drift instead of the estimate (until the next learn).
-  void set_temperature(double degc) noexcept { estimator_.set_temperature(degc); }
+  // A measured temperature [degC] replaces the estimate until the next set_temperature() or
+  // clear_temperature() (header comment): the drift is set from the coefficients per K (with the
+  // model's fitted coefficients epsilon and lambda are its sensor polynomials there, and the
+  // reconstruction takes all six scales from them). Meanwhile the estimator learns nothing (its
+  // anchor drops, the thermal model does not carry it): a sensor that fails leaves the estimate
+  // at its last temperature. Not finite: ignored.
+  void set_temperature(double degc) noexcept;
+  // Back to the estimated drift, learning from the next samples on.
+  void clear_temperature() noexcept { measured_degc_ = kNoTemperature; }
+  // The model carries fitted temperature coefficients.
+  [[nodiscard]] bool has_temperature_coefficients() const noexcept {
+    return coefficients_.has_value();
+  }
   void set_frozen(bool frozen) noexcept { estimator_.set_frozen(frozen); }
   [[nodiscard]] const models::StatusCounts& counts() const noexcept { return counts_; }
   [[nodiscard]] bool has_strain() const noexcept { return kernel_.actuator().has_value(); }
@@ -139,6 +166,14 @@ class AdaptedReconstruction final {
   AdaptedReconstruction(const models::TransducerModel& model, const DriftEstimatorConfig& config,
                         double range_margin, Tag /*unused*/);
   Estimate kernel_step(double field, double sensed, bool accepted) noexcept;
+  // The six scales of the parts (header comment): sensor L, H, coupling; actuator L, H,
+  // compliance.
+  struct Scales {
+    double sensor_linear, sensor_loop, sensor_coupling;
+    double actuator_linear, actuator_loop, actuator_compliance;
+  };
+  [[nodiscard]] Scales scales(const Drift& dr) const noexcept;
+  static constexpr double kNoTemperature = -1.0e300;
 
   models::Reconstructor kernel_;
   SideSplit sensor_split_;
@@ -152,6 +187,8 @@ class AdaptedReconstruction final {
   models::ModelIdentity identity_{};
   double mount_ratio_{0.0};  // r
   double mount_kappa_{0.0};  // r / s_a [Pa per unit strain]
+  std::optional<models::TemperatureCoefficients> coefficients_{};
+  double measured_degc_{kNoTemperature};  // kNoTemperature: none
 };
 
 }  // namespace selfsense::adaptation

@@ -115,6 +115,8 @@ class DriftEstimator final {
   // Sets the drift from a measured temperature instead of learning it (a temperature sensor):
   // epsilon = permittivity_per_k dT, lambda = loop_per_k dT.
   void set_temperature(double degc) noexcept;
+  // Sets epsilon and lambda (clamped to +-max_relative_change; not finite: ignored).
+  void set_drift(double permittivity, double loop) noexcept;
   // Moves the estimate along a predicted temperature change (thermal_model.hpp) without
   // learning: epsilon += permittivity_per_k delta, lambda += loop_per_k delta [delta in K],
   // clamped to +-max_relative_change. Ignored when frozen or not finite.

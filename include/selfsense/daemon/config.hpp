@@ -40,6 +40,7 @@
 //     learn_loop, min_field_step_v_per_m, max_interval_s, memory_updates, initial_variance,
 //     max_relative_change, reference_degc, permittivity_per_k, loop_per_k, coupling_per_k,
 //     compliance_per_k, load_stiffness_ratio   # adaptation::DriftEstimatorConfig's keys
+//     use_temperature: false            # true: the driver's temp replaces the estimate
 //   health:                             # health from E and D, alarms (docs/health.md)
 //     enabled: false                    # true: the loop runs adaptation::HealthEstimator
 //     fault: false                      # true: an alarm is also a fault (safe output)
@@ -133,6 +134,10 @@ struct TelemetrySection {
 struct AdaptationSection {
   bool enabled{false};
   adaptation::DriftEstimatorConfig estimator{};  // `frozen` is the estimator's
+  // The driver's temperature (temp_ref) replaces the estimate in every cycle it is finite
+  // (AdaptedReconstruction::set_temperature: with the model's fitted temperature coefficients,
+  // docs/adaptation.md); in a cycle without it the estimate serves again.
+  bool use_temperature{false};
   friend bool operator==(const AdaptationSection&, const AdaptationSection&) = default;
 };
 

@@ -27,6 +27,10 @@
 //   corrections:                         # physics added by `selfsense diagnose`, optional
 //     sensed: {gain, offset, leakage_tau_s, delay_s, ...}   # (models/channel_correction.hpp)
 //     strain: {gain, creep_eigenvalues, creep_weights, dynamics_frequency_hz, ...}
+//   temperature:                         # optional, field drive: how the sides change with
+//     reference_degc: 25.0               # temperature (models/temperature_coefficients.hpp),
+//     sensor: {linear: [per_k, per_k2], loop: [...], coupling: [...]}   # fitted on a ramp
+//     actuator: {linear: [...], loop: [...], coupling: [...]}           # recording
 //   fit: {...}                           # free-form notes written by identify, not read back
 //   complete: true                       # format 2: the last key; a file cut short lacks it
 // Loading is strict: unknown keys, missing fields, wrong types and parameters that make an

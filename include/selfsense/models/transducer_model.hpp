@@ -33,6 +33,7 @@
 #include "selfsense/models/geometry.hpp"
 #include "selfsense/models/side_model.hpp"
 #include "selfsense/models/stress_hysteresis.hpp"
+#include "selfsense/models/temperature_coefficients.hpp"
 
 namespace selfsense::models {
 
@@ -76,6 +77,11 @@ struct TransducerModel {
   // models.
   std::optional<ChannelCorrection> sensed_correction{};
   std::optional<ChannelCorrection> strain_correction{};
+  // How the sides change with temperature (temperature_coefficients.hpp), fitted on a ramp
+  // recording; field drive only. Used where the temperature is measured
+  // (adaptation/adapted_reconstruction.hpp); the plain runtime models ignore it, and it is not
+  // part of the parameter hash (it does not change the operators' state).
+  std::optional<TemperatureCoefficients> temperature{};
 
   [[nodiscard]] Drive drive() const noexcept { return drive_of(structure); }
   // The operator parameters and couplings are valid and the sample times agree.

@@ -81,6 +81,10 @@ struct LoopConfig {
   double watchdog_s{0.0};
   std::uint32_t status_period{100};  // cycles between status snapshots
   std::size_t command_capacity{64};
+  // With the adapted reconstruction: the driver's temp_ref, where finite, replaces the
+  // estimate in that cycle (AdaptedReconstruction::set_temperature; clear_temperature() in a
+  // cycle without it).
+  bool adaptation_temperature{false};
   bool health_enabled{false};
   adaptation::HealthEstimatorConfig health{};
   adaptation::HealthBands health_bands{};

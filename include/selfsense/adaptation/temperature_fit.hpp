@@ -1,0 +1,54 @@
+// Fits a model's temperature coefficients (models/temperature_coefficients.hpp) on a recording
+// with a temperature channel, such as a ramp (issue 24 items 1 and 5, docs/adaptation.md
+// "Temperature coefficients"). The model's operators stay as identified at the reference
+// temperature; only how its parts scale with the temperature change is fitted.
+//
+// The model runs along the recording's field; per sample, with each side's response split into
+// its linear part L and loop H (adapted_reconstruction.hpp's SideSplit), dtheta = temp -
+// reference_degc [K], the measured stress T [Pa], D [C/m^2] and S [-]:
+//   sensor:   D - y0_s - q_s E^2 - L_s - H_s - d_s T
+//               = (a1 dtheta + a2 dtheta^2) L_s + (b1 dtheta + b2 dtheta^2) H_s
+//                 + (c1 dtheta + c2 dtheta^2) d_s T
+//   actuator: S - y0_a - q_a E^2 - L_a - H_a - s_a T   = the same with the actuator's parts
+// Linear least squares per side in six coefficients (three with quadratic false), each column
+// scaled to unit norm, a ridge of 1e-9 of the diagonal against a column that vanishes (a stress
+// that never moves). The result is the effective drift of the model's split, which is not
+// exactly the plant's permittivity and loop (docs/adaptation.md, "the split is the floor").
+//
+// Offline: allocates, throws.
+#pragma once
+
+#include <cstddef>
+#include <span>
+
+#include "selfsense/models/temperature_coefficients.hpp"
+#include "selfsense/models/transducer_model.hpp"
+
+namespace selfsense::adaptation {
+
+struct TemperatureFitInput {
+  std::span<const double> field;        // E [V/m]
+  std::span<const double> sensed;       // D [C/m^2]
+  std::span<const double> stress;       // T [Pa], measured on the bench
+  std::span<const double> strain;       // S [-], measured on the bench
+  std::span<const double> temperature;  // [degC]
+};
+
+struct TemperatureFitResult {
+  models::TemperatureCoefficients coefficients{};
+  double sensor_rms_before{0.0};    // RMS of the sensor side's residual, no coefficients [C/m^2]
+  double sensor_rms_after{0.0};     // with them
+  double actuator_rms_before{0.0};  // the actuator side's [-]
+  double actuator_rms_after{0.0};
+  std::size_t samples{0};  // finite samples used
+};
+
+// Throws std::invalid_argument naming the reason: a model that is not field-driven with both
+// sides (or vectorial, or with corrections), columns of different lengths, fewer than 100
+// samples, or a temperature that spans less than min_span_k.
+[[nodiscard]] TemperatureFitResult fit_temperature(const models::TransducerModel& model,
+                                                   const TemperatureFitInput& in,
+                                                   double reference_degc, bool quadratic = true,
+                                                   double min_span_k = 2.0);
+
+}  // namespace selfsense::adaptation

@@ -1,0 +1,152 @@
+// The temperature coefficients (adaptation/temperature_fit.hpp) on synthetic data whose drift is
+// known: a typical transducer whose parts scale with a temperature ramp by given polynomials.
+// The fit recovers them, the adapted reconstruction with them and the measured temperature
+// recovers T and S, and nothing allocates per sample.
+#include "selfsense/adaptation/temperature_fit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <vector>
+
+#include "selfsense/adaptation/adapted_reconstruction.hpp"
+#include "support/allocation_counter.hpp"
+#include "support/transducer_data.hpp"
+
+namespace selfsense::adaptation {
+namespace {
+
+constexpr double kTs = 1e-4;
+
+struct Ramp {
+  models::TransducerModel model;
+  std::vector<double> e, d, t, s, temp;
+};
+
+// The truth: sensor L +4e-3/K -2e-6/K^2, H -4e-3/K +3e-6/K^2, d +2e-3/K; actuator L +2e-3/K,
+// H -4e-3/K, s +5e-4/K +1e-6/K^2; about 25 degC, warming 25 -> 55 degC.
+models::TemperatureCoefficients truth() {
+  models::TemperatureCoefficients c;
+  c.reference_degc = 25.0;
+  c.sensor = {{4e-3, -2e-6}, {-4e-3, 3e-6}, {2e-3, 0.0}};
+  c.actuator = {{2e-3, 0.0}, {-4e-3, 0.0}, {5e-4, 1e-6}};
+  return c;
+}
+
+Ramp ramp(std::size_t n) {
+  Ramp out{test::typical_transducer(kTs), {}, {}, {}, {}, {}};
+  const models::TemperatureCoefficients c = truth();
+  models::SideOperator sensor(*out.model.sensor);
+  models::SideOperator actuator(*out.model.actuator);
+  const SideSplit split_s(sensor);
+  const SideSplit split_a(actuator);
+  double lo = 1e300;
+  double hi = -1e300;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double time = static_cast<double>(k) * kTs;
+    const double e = 1e6 * (1.0 + 0.9 * std::sin(2 * std::numbers::pi * 3.0 * time) *
+                                      std::cos(2 * std::numbers::pi * 0.23 * time));
+    const double t = -1e7 * (1.0 + 0.5 * std::sin(2 * std::numbers::pi * 0.7 * time + 0.5));
+    const double temp = 25.0 + 30.0 * static_cast<double>(k) / static_cast<double>(n);
+    const double dt = temp - c.reference_degc;
+    const SideSplit::Parts ps =
+        split_s.split(sensor, e, sensor.step_unloaded(e) - out.model.sensor->offset);
+    const SideSplit::Parts pa =
+        split_a.split(actuator, e, actuator.step_unloaded(e) - out.model.actuator->offset);
+    const double d = out.model.sensor->offset + c.sensor.linear.scale(dt) * ps.linear +
+                     c.sensor.loop.scale(dt) * ps.loop +
+                     c.sensor.coupling.scale(dt) * sensor.coupling() * t;
+    const double s = out.model.actuator->offset + c.actuator.linear.scale(dt) * pa.linear +
+                     c.actuator.loop.scale(dt) * pa.loop +
+                     c.actuator.coupling.scale(dt) * actuator.coupling() * t;
+    out.e.push_back(e);
+    out.d.push_back(d);
+    out.t.push_back(t);
+    out.s.push_back(s);
+    out.temp.push_back(temp);
+    lo = std::min(lo, d);
+    hi = std::max(hi, d);
+  }
+  out.model.drive_range = models::InputRange{0.0, 2e6};
+  out.model.sensed_range = models::InputRange{lo, hi};
+  return out;
+}
+
+void expect_polynomial(const models::TemperaturePolynomial& fitted,
+                       const models::TemperaturePolynomial& want) {
+  EXPECT_NEAR(fitted.per_k, want.per_k, 1e-7);
+  EXPECT_NEAR(fitted.per_k2, want.per_k2, 1e-8);
+}
+
+TEST(TemperatureFit, RecoversKnownCoefficients) {
+  const Ramp r = ramp(40000);
+  const TemperatureFitResult fit = fit_temperature(r.model, {r.e, r.d, r.t, r.s, r.temp}, 25.0);
+  const models::TemperatureCoefficients want = truth();
+  EXPECT_EQ(fit.samples, r.e.size());
+  EXPECT_EQ(fit.coefficients.reference_degc, 25.0);
+  expect_polynomial(fit.coefficients.sensor.linear, want.sensor.linear);
+  expect_polynomial(fit.coefficients.sensor.loop, want.sensor.loop);
+  expect_polynomial(fit.coefficients.sensor.coupling, want.sensor.coupling);
+  expect_polynomial(fit.coefficients.actuator.linear, want.actuator.linear);
+  expect_polynomial(fit.coefficients.actuator.loop, want.actuator.loop);
+  expect_polynomial(fit.coefficients.actuator.coupling, want.actuator.coupling);
+  EXPECT_LT(fit.sensor_rms_after, 1e-6 * fit.sensor_rms_before);
+  EXPECT_LT(fit.actuator_rms_after, 1e-6 * fit.actuator_rms_before);
+  // First order only: the quadratic terms are left out.
+  const TemperatureFitResult linear =
+      fit_temperature(r.model, {r.e, r.d, r.t, r.s, r.temp}, 25.0, false);
+  EXPECT_EQ(linear.coefficients.sensor.linear.per_k2, 0.0);
+  EXPECT_GT(linear.sensor_rms_after, fit.sensor_rms_after);
+}
+
+TEST(TemperatureFit, RefusesWhatItCannotFit) {
+  const Ramp r = ramp(2000);
+  const std::vector<double> flat(r.e.size(), 30.0);
+  EXPECT_THROW(static_cast<void>(fit_temperature(r.model, {r.e, r.d, r.t, r.s, flat}, 25.0)),
+               std::invalid_argument);
+  const std::span<const double> shorter = std::span<const double>(r.s).first(100);
+  EXPECT_THROW(static_cast<void>(fit_temperature(r.model, {r.e, r.d, r.t, shorter, r.temp}, 25.0)),
+               std::invalid_argument);
+  models::TransducerModel one_side = r.model;
+  one_side.actuator.reset();
+  EXPECT_THROW(static_cast<void>(fit_temperature(one_side, {r.e, r.d, r.t, r.s, r.temp}, 25.0)),
+               std::invalid_argument);
+}
+
+// With the coefficients in the model and the measured temperature, T and S come back (to the
+// rounding of the synthetic data); without the coefficients (the estimator's defaults, which
+// leave out the quadratic terms and the actuator's own loop) they do not as well.
+TEST(TemperatureFit, TheAdaptedReconstructionUsesThemWithAMeasuredTemperature) {
+  Ramp r = ramp(40000);
+  DriftEstimatorConfig config{};
+  config.frozen = true;
+  AdaptedReconstruction without(r.model, config);
+  r.model.temperature = truth();
+  AdaptedReconstruction with(r.model, config);
+  EXPECT_TRUE(with.has_temperature_coefficients());
+  double err_with = 0.0;
+  double err_without = 0.0;
+  double err_strain = 0.0;
+  test::AllocationCounter counter;
+  for (std::size_t k = 0; k < r.e.size(); ++k) {
+    with.set_temperature(r.temp[k]);
+    without.set_temperature(r.temp[k]);
+    const AdaptedReconstruction::Estimate a = with.step(r.e[k], r.d[k]);
+    const AdaptedReconstruction::Estimate b = without.step(r.e[k], r.d[k]);
+    err_with = std::max(err_with, std::abs(a.stress - r.t[k]));
+    err_without = std::max(err_without, std::abs(b.stress - r.t[k]));
+    err_strain = std::max(err_strain, std::abs(a.strain - r.s[k]));
+  }
+  EXPECT_EQ(counter.count(), 0U);
+  EXPECT_LT(err_with, 1.0);  // [Pa], of a stress of about 1e7 Pa
+  EXPECT_LT(err_strain, 1e-12);
+  EXPECT_GT(err_without, 1e3 * err_with);
+  // Cleared, the estimate (here frozen at the last measured temperature) serves again.
+  with.clear_temperature();
+  EXPECT_NEAR(with.drift().temperature_degc, r.temp.back(), 1e-6);
+}
+
+}  // namespace
+}  // namespace selfsense::adaptation
