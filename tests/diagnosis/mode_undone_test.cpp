@@ -14,8 +14,7 @@ namespace selfsense::diagnosis {
 namespace {
 
 // v through the stage's mode (its filters alone).
-std::vector<double> through_mode(const std::vector<double>& v, double hz, double zeta,
-                                 double ts) {
+std::vector<double> through_mode(const std::vector<double>& v, double hz, double zeta, double ts) {
   models::ChannelCorrection c;
   c.dynamics_frequency_hz = hz;
   c.dynamics_damping = zeta;
