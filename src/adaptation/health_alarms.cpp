@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "selfsense/base/check.hpp"
+
 namespace selfsense::adaptation {
 
 std::string_view to_string(HealthAlarm a) noexcept {
@@ -19,18 +21,13 @@ std::string_view to_string(HealthAlarm a) noexcept {
 }
 
 bool HealthBands::is_valid(const std::string& prefix, std::string* why) const {
-  const auto fail = [&](const char* message) {
-    if (why != nullptr) *why = prefix + message;
-    return false;
-  };
-  if (!std::isfinite(max_temperature_degc)) return fail("max_temperature_degc: must be finite");
-  if (!(max_depolarisation_pct > 0.0 && max_depolarisation_pct < 100.0)) {
-    return fail("max_depolarisation_pct: must be in (0, 100)");
-  }
-  if (!(std::isfinite(min_leakage_resistivity_ohm_m) && min_leakage_resistivity_ohm_m > 0.0)) {
-    return fail("min_leakage_resistivity_ohm_m: must be finite and > 0");
-  }
-  return true;
+  namespace check = base::check;
+  const auto key = [&prefix](const char* name) { return prefix + name; };
+  return check::finite(key("max_temperature_degc"), max_temperature_degc, why) &&
+         check::require(max_depolarisation_pct > 0.0 && max_depolarisation_pct < 100.0,
+                        key("max_depolarisation_pct"), max_depolarisation_pct,
+                        "must be within (0, 100)", why) &&
+         check::positive(key("min_leakage_resistivity_ohm_m"), min_leakage_resistivity_ohm_m, why);
 }
 
 std::uint32_t HealthAlarms::evaluate(const HealthFigures& f, bool has_temperature,

@@ -1,6 +1,6 @@
 // `selfsense identify`: fits a transducer model of a named structure to a recording with
 // reference channels, on its first part, and reports the fit on that part and on the held-out
-// rest (contracts.md).
+// rest (docs/recording-format.md).
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>

@@ -1,6 +1,6 @@
 // `selfsense import`: brings recordings of other instruments into the CSV format of
-// contracts.md. Sub-commands per source format: `aixacct` (aixACCT aixPlorer ASCII export) and
-// `columns` (any delimited text).
+// docs/recording-format.md. Sub-commands per source format: `aixacct` (aixACCT aixPlorer ASCII
+// export) and `columns` (any delimited text).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>

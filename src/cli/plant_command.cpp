@@ -1,7 +1,7 @@
 // `selfsense plant`: runs the simulated stack (selfsense::plant) over a generated or recorded
-// excitation and writes a recording (contracts.md): measured t, E, D; the plant's true S and T
-// as reference columns; temp where the temperature varies; the true terminal values (u, q, x, F:
-// E_true, D_true, S, T through the geometry) and diagnostic columns (q_amp, p, status).
+// excitation and writes a recording (docs/recording-format.md): measured t, E, D; the plant's true
+// S and T as reference columns; temp where the temperature varies; the true terminal values (u, q,
+// x, F: E_true, D_true, S, T through the geometry) and diagnostic columns (q_amp, p, status).
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdint>

@@ -1,5 +1,5 @@
-// `selfsense simulate` and `selfsense reconstruct` (contracts.md): run a model over a recording
-// and write its outputs beside the recorded columns.
+// `selfsense simulate` and `selfsense reconstruct` (docs/recording-format.md): run a model over a
+// recording and write its outputs beside the recorded columns.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -67,7 +67,7 @@ void report(const ModelRuns& runs, const models::StatusCounts& counts) {
 }
 
 // Where the recording holds the reference (a bench or plant recording): the estimates' figures
-// (contracts.md: nrmse and max relative to the reference's range), and the equivalent
+// (docs/recording-format.md: nrmse and max relative to the reference's range), and the equivalent
 // temperature's error against a recorded temperature.
 void report_figures(const io::Recording& rec, const FieldSignals& signals) {
   const auto print = [](const char* name, std::span<const double> reference,

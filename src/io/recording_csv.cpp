@@ -1,4 +1,4 @@
-// Strict CSV reader and writer for recordings (format: shared/docs/contracts.md).
+// Strict CSV reader and writer for recordings (format: docs/recording-format.md).
 //
 // The reader maps the whole file and parses it in place with std::from_chars: no allocation
 // per cell, columns reserved from a count of the line breaks. Rows take a fast path that only

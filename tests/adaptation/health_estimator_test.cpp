@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <string>
@@ -279,7 +280,15 @@ TEST(HealthEstimator, TheConfigurationNamesTheViolatedKey) {
   HealthBands bands;
   bands.max_depolarisation_pct = 0.0;
   EXPECT_FALSE(bands.is_valid("health.", &why));
-  EXPECT_EQ(why, "health.max_depolarisation_pct: must be in (0, 100)");
+  EXPECT_EQ(why, "health.max_depolarisation_pct: 0 must be within (0, 100)");
+  bands = {};
+  bands.max_temperature_degc = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(bands.is_valid("health.", &why));
+  EXPECT_EQ(why, "health.max_temperature_degc: nan must be finite");
+  bands = {};
+  bands.min_leakage_resistivity_ohm_m = -1.0;
+  EXPECT_FALSE(bands.is_valid("health.", &why));
+  EXPECT_EQ(why, "health.min_leakage_resistivity_ohm_m: -1 must be > 0");
 }
 
 TEST(TrendFilter, ARampHasItsSlopeAndTheValueLagsByTau1) {

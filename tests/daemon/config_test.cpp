@@ -213,11 +213,11 @@ TEST(DaemonConfig, TheHealthSectionIsReadStrictlyAndValidated) {
   EXPECT_TRUE(has(slope, "health.slope_time_s: must be > trend_time_s")) << slope.problems.front();
   const ConfigResult band =
       load_sim("health-band", {{"max_depolarisation_pct: 3.0", "max_depolarisation_pct: 120"}});
-  EXPECT_TRUE(has(band, "health.max_depolarisation_pct: must be in (0, 100)"))
+  EXPECT_TRUE(has(band, "health.max_depolarisation_pct: 120 must be within (0, 100)"))
       << band.problems.front();
   const ConfigResult rho = load_sim(
       "health-rho", {{"min_leakage_resistivity_ohm_m: 1.0e9", "min_leakage_resistivity_ohm_m: 0"}});
-  EXPECT_TRUE(has(rho, "health.min_leakage_resistivity_ohm_m: must be finite and > 0"))
+  EXPECT_TRUE(has(rho, "health.min_leakage_resistivity_ohm_m: 0 must be > 0"))
       << rho.problems.front();
   const ConfigResult unknown = load_sim("health-unknown", {{"  dissipation_per_k: -4.0e-3",
                                                             "  dissipation_per_k: -4.0e-3\n"

@@ -5,7 +5,8 @@
 // accepted.
 // Properties:
 //  - load_config never throws;
-//  - every problem starts with "FILE:LINE: " (contracts.md: `FILE:LINE: KEY.PATH: what`) and is
+//  - every problem starts with "FILE:LINE: " (docs/daemon.md, "Start": `FILE:LINE: KEY.PATH: what`)
+//  and is
 //    one line;
 //  - an accepted configuration has a loop config the loop takes (rate and sample time finite and
 //    positive) and the registry builds its driver's configuration without an exception.

@@ -1,4 +1,4 @@
-// Tests of the recording CSV reader and writer against the contract in shared/docs/contracts.md.
+// Tests of the recording CSV reader and writer against the format in docs/recording-format.md.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <unistd.h>

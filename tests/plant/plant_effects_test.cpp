@@ -374,7 +374,7 @@ TEST(PlantEffects, StressCouplingGeneratesNoEnergy) {
   EXPECT_NEAR(test::loop_energy(out, cycle, 2 * cycle), 0.0, 1e-6);  // J/m^3
 }
 
-// The terminal values are the field values through the geometry (physics.md).
+// The terminal values are the field values through the geometry (docs/recording-format.md).
 TEST(PlantEffects, TerminalValuesFollowTheGeometry) {
   PlantConfig c{};
   c.hysteresis.enabled = true;

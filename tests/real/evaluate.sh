@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Evaluation on the measured data sets in ../shared/data/real (see docs/real-data.md): imports
 # every set with `selfsense import`, identifies on one part, validates on another and prints
-# nrmse and max per channel (contracts.md, in % of the recorded range of that part).
+# nrmse and max per channel (docs/recording-format.md, in % of the recorded range of that part).
 # The data are read where they lie and never copied into the repository (the disc set has no
 # licence). Usage: evaluate.sh SELFSENSE_BINARY DATA_DIR [FIGURES_AWK]
 # Exit status: 1 when an asserted figure or finding is missed, a step fails, or DATA_DIR or one

@@ -1,4 +1,4 @@
-# Fit figures of contracts.md over a time window of a simulated recording:
+# Fit figures of docs/recording-format.md over a time window of a simulated recording:
 #   nrmse = RMS(ref - est) / range(ref), max = max|ref - est| / range(ref), both in %.
 # usage: awk -F, -v ref=S -v est=S_model [-v from=T0] [-v to=T1] -f figures.awk SIM.csv
 # Prints "NRMSE MAX T_AT_MAX"; "nan nan nan" when the window is empty or the channels absent.

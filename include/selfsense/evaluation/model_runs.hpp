@@ -1,6 +1,6 @@
 // Runs a transducer model over a whole recording (forward and reconstruction, through the
 // runtime model types at the recording's sample rate) and computes the fit figures of
-// contracts.md per channel.
+// docs/recording-format.md per channel.
 #pragma once
 
 #include <cstddef>

@@ -1,4 +1,4 @@
-// Fit figures as ../shared/docs/contracts.md defines them: the RMS and the largest absolute
+// Fit figures as docs/recording-format.md defines them: the RMS and the largest absolute
 // value of (recorded - model), each divided by the recorded channel's range (max - min).
 #pragma once
 

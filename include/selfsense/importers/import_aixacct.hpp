@@ -2,7 +2,8 @@
 // block per measurement: a line "Table <n>", "Key: value" metadata, a tab-separated header that
 // starts with "Time [s]" and the rows up to the next blank line.
 //
-// One block becomes a recording (contracts.md), h the sample thickness, A its electrode area:
+// One block becomes a recording (docs/recording-format.md), h the sample thickness, A its
+// electrode area:
 //   E = (V+ - V-) / h              [V/m]
 //   D = P1 * 1e-2 - I0 * (t - t0) / A   [C/m^2]  (P1 in uC/cm2 is the integrated current / A)
 //   S = D1 * 1e-9 / h              [-]      (D1: interferometer displacement in nm)

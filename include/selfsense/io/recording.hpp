@@ -1,4 +1,4 @@
-// Recordings: the CSV format of ../shared/docs/contracts.md held in memory.
+// Recordings: the CSV format of docs/recording-format.md held in memory.
 //
 // A recording is a set of named columns of equal length (SI units: t s, E V/m, D C/m^2,
 // S -, T Pa, temp degC; any other column is carried through untouched) plus the '#' comment

@@ -1,5 +1,5 @@
-// A run of the simulated stack as files (`selfsense plant`, contracts.md): the excitation read
-// from a recording, and the run written as a recording.
+// A run of the simulated stack as files (`selfsense plant`, docs/recording-format.md): the
+// excitation read from a recording, and the run written as a recording.
 #pragma once
 
 #include <filesystem>

@@ -32,7 +32,7 @@ struct ReportFigure {
 };
 
 struct ReportFinding {
-  std::string effect{};  // physics.md word: creep, charge_leakage, ...
+  std::string effect{};  // docs/diagnose.md "What each effect becomes": creep, charge_leakage, ...
   std::string channel{};
   std::vector<ReportSegment> where{};
   double explains{0.0};  // share of the residual variance removed
