@@ -1,8 +1,8 @@
-// The candidates of a diagnosis: each effect of physics.md a channel correction can add, as a
-// unit that carries its terms (identification/correction_fit.hpp), the channels it applies to,
-// the signals it needs, its parameter count (complexity of its terms) and its own description of
-// what it found. Adding an effect is one entry of candidates() (candidates.cpp) and its test.
-// Pure math.
+// The candidates of a diagnosis: each effect a channel correction can add (docs/diagnose.md,
+// "What each effect becomes"), as a unit that carries its terms
+// (identification/correction_fit.hpp), the channels it applies to, the signals it needs, its
+// parameter count (complexity of its terms) and its own description of what it found. Adding an
+// effect is one entry of candidates() (candidates.cpp) and its test. Pure math.
 #pragma once
 
 #include <cstddef>
@@ -36,7 +36,7 @@ struct Evidence {
 using Describe = void (*)(Finding&, const Evidence&);
 
 struct Candidate {
-  const char* effect;  // physics.md word
+  const char* effect;  // the effect's name (docs/diagnose.md)
   std::vector<CorrectionTerm> terms;
   bool on_sensed;  // the reconstruction can invert it on the sensed channel
   bool on_strain;

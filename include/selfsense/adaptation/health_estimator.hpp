@@ -8,7 +8,7 @@
 // capacitance there is the first slope of D after the reversal:
 //   C_rev = (D[k] - D_x) / (E[k] - E_x)                                            [F/m]
 // (a Preisach loop leaves a reversal with zero slope, so this is the permittivity and what
-// moves with it; physics.md: "dD/dE on small reversals").
+// moves with it: the permittivity seen as dD/dE on small reversals, docs/health.md).
 //
 // Dissipation: a full cycle runs from one reversal at a minimum to the next (samples a..b). The
 // loop area, closed by the chord from b back to a:

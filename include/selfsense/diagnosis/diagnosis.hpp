@@ -4,7 +4,7 @@
 //
 // For each output channel the model has and the recording references (D, S):
 //   1. residual e = recorded - model; correlation tests and large segments (residual_tests.hpp)
-//   2. every candidate effect of physics.md that the channel can show (src/diagnosis/
+//   2. every candidate effect (docs/diagnose.md) that the channel can show (src/diagnosis/
 //      candidates.cpp) is fitted as a correction (models/channel_correction.hpp,
 //      identification/correction_fit.hpp) on the fitting blocks only (alternate twentieths of
 //      the record), and judged on the other blocks: explains = 1 - SSE_after / SSE_before there
@@ -76,7 +76,7 @@ struct Alternative {
 };
 
 struct Finding {
-  std::string effect{};   // physics.md word
+  std::string effect{};   // the effect's name (docs/diagnose.md)
   std::string channel{};  // "D" / "S" (or "E" for charge drive)
   std::vector<Segment> where{};
   double explains{0.0};

@@ -13,9 +13,9 @@
 //      steps on log m against log sqrt(ratio^2 - 1) (the effect's own share of the residual,
 //      about proportional to m); creep_leakage calibrates each part alone, then both together
 //   4. diagnose that base on that recording (drive E, sensed D, strain S, stress T, temp)
-//   5. validation nrmse (RMS / range, contracts.md) per channel on the validation recording:
-//      before (the base), after (the improved model), clean (the clean base on the effect-free
-//      validation recording)
+//   5. validation nrmse (RMS / range, docs/recording-format.md) per channel on the validation
+//      recording: before (the base), after (the improved model), clean (the clean base on the
+//      effect-free validation recording)
 // Outcome: named_right when every expected effect word is named on its channel (the affected
 // channel with the larger ratio; leakage on D), extra_names the findings that name anything
 // else, the excess ratio (after - clean) / (before - clean) of the judged channel(s) (the
