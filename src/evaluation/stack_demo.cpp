@@ -33,15 +33,16 @@ double loop_width(const std::vector<double>& e, const std::vector<double>& s,
 
 }  // namespace
 
-StackDemoFigures stack_demo(const StackDemoSettings& opt) {
+StackDemoFigures stack_demo(const StackDemoSettings& settings) {
   StackDemoFigures out;
-  const double ts = 1.0 / opt.sample_rate;
+  const double ts = 1.0 / settings.sample_rate;
   const HysteresisCreep::Params params = operators::typical_stack_strain();
 
   // 1. Sine between 0 and full field.
   HysteresisCreep stack(params, ts);
-  const auto per_cycle = static_cast<std::size_t>(std::lround(opt.sample_rate / opt.sine_hz));
-  const std::size_t n = per_cycle * static_cast<std::size_t>(opt.cycles);
+  const auto per_cycle =
+      static_cast<std::size_t>(std::lround(settings.sample_rate / settings.sine_hz));
+  const std::size_t n = per_cycle * static_cast<std::size_t>(settings.cycles);
   std::vector<double> e(n);
   std::vector<double> s(n);
   for (std::size_t k = 0; k < n; ++k) {
@@ -59,17 +60,17 @@ StackDemoFigures stack_demo(const StackDemoSettings& opt) {
 
   // 2. Staircase with holds: creep after each step.
   HysteresisCreep stair(params, ts);
-  const double step_field = kTypicalFieldMax / opt.steps;
-  const auto hold = static_cast<std::size_t>(std::lround(opt.hold_s * opt.sample_rate));
-  out.decades = std::log10(opt.hold_s / 0.1);
+  const double step_field = kTypicalFieldMax / settings.steps;
+  const auto hold = static_cast<std::size_t>(std::lround(settings.hold_s * settings.sample_rate));
+  out.decades = std::log10(settings.hold_s / 0.1);
   double before = 0.0;
-  for (int i = 1; i <= opt.steps; ++i) {
+  for (int i = 1; i <= settings.steps; ++i) {
     const double field = step_field * i;
     double at_01 = 0.0;
     double at_end = 0.0;
     for (std::size_t k = 0; k < hold; ++k) {
       const double y = stair.step(field);
-      if (k + 1 == static_cast<std::size_t>(std::lround(0.1 * opt.sample_rate))) at_01 = y;
+      if (k + 1 == static_cast<std::size_t>(std::lround(0.1 * settings.sample_rate))) at_01 = y;
       at_end = y;
     }
     out.stairs.push_back({field, at_end - before, at_end - at_01});
