@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
@@ -59,18 +60,25 @@ const models::TransducerModel& main_job_model() {
   return model;
 }
 
+// A plant file of config/plant/ with config/plant/temperature.yaml's coefficients and the
+// noise seed `seed`.
+plant::PlantFile warming_plant(const char* name, std::uint64_t seed) {
+  plant::PlantFile f =
+      plant::load_plant_file(std::string(SELFSENSE_SOURCE_DIR "/config/plant/") + name);
+  f.plant.temperature =
+      plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/temperature.yaml")
+          .plant.temperature;
+  f.plant.seed = seed;
+  return f;
+}
+
 // The main job's model with temperature coefficients fitted on a ramp recording (issue 24 items 1
 // and 5): the identification plant and excitation (config/plant/reconstruction.yaml, seed 2:
 // other noise than the model's recording) with config/plant/temperature.yaml's coefficients,
 // warming 25 -> 55 degC. The validation recordings' excitation (mix) is never seen.
 const models::TransducerModel& model_with_coefficients() {
   static const models::TransducerModel model = [] {
-    plant::PlantFile f =
-        plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction.yaml");
-    f.plant.temperature =
-        plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/temperature.yaml")
-            .plant.temperature;
-    f.plant.seed = 2;
+    plant::PlantFile f = warming_plant("reconstruction.yaml", 2);
     plant::Excitation ex =
         plant::make_excitation("identification", f.excitation, f.plant.sample_rate_hz, 2);
     f.excitation.temperature = {25.0, 55.0};
@@ -101,12 +109,7 @@ const models::TransducerModel& model_with_coefficients() {
 // swinging, below).
 Recorded warming_recording(std::uint64_t seed, double start_degc, double end_degc, int repeats,
                            bool swings = false) {
-  plant::PlantFile f =
-      plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction-validation.yaml");
-  const plant::PlantFile heat =
-      plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/temperature.yaml");
-  f.plant.temperature = heat.plant.temperature;
-  f.plant.seed = seed;
+  plant::PlantFile f = warming_plant("reconstruction-validation.yaml", seed);
   plant::Excitation one = plant::make_excitation("mix", f.excitation, f.plant.sample_rate_hz, seed);
   plant::Excitation ex = one;
   for (int i = 1; i < repeats; ++i) {
@@ -283,12 +286,7 @@ TEST(AdaptationAccuracy, SlowRandomSwingsWithoutTemperatureInput) {
 // degC at the hold (the estimate lags a 30 K ramp over 100 s by 3.3 K), T_hat RMS error over
 // the hold 3.9e5 Pa.
 TEST(AdaptationAccuracy, NoDriftOverATenMinuteHold) {
-  plant::PlantFile f =
-      plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/reconstruction-validation.yaml");
-  f.plant.temperature =
-      plant::load_plant_file(SELFSENSE_SOURCE_DIR "/config/plant/temperature.yaml")
-          .plant.temperature;
-  f.plant.seed = 22;
+  plant::PlantFile f = warming_plant("reconstruction-validation.yaml", 22);
   plant::Excitation ex = plant::make_excitation("mix", f.excitation, f.plant.sample_rate_hz, 22);
   const std::size_t ramp = ex.size();
   const auto hold = static_cast<std::size_t>(600.0 * f.plant.sample_rate_hz);
