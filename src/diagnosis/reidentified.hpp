@@ -58,6 +58,10 @@ struct Reidentified {
 [[nodiscard]] Rows forecast_rows(std::size_t n, std::size_t half, std::size_t judging,
                                  const std::vector<double>& a, const std::vector<double>& b);
 
+// The same for a backcast: the samples from `half` on fit, the first `half` judge.
+[[nodiscard]] Rows backcast_rows(std::size_t n, std::size_t half, std::size_t judging,
+                                 const std::vector<double>& a, const std::vector<double>& b);
+
 // Where a re-identified model's output departs most from the current one (the whole record when
 // the change is spread evenly): a finding's located segments.
 [[nodiscard]] std::vector<Segment> where_it_changes(const std::vector<double>& output,
@@ -67,7 +71,9 @@ struct Reidentified {
 // fitted by min_explains better) and the forecast, or the forecast alone. Beside a creep
 // structure the fit cannot show a slow leak: over the half it is fitted on, the slowest lags
 // integrate like the leak and take it in; past it the lags settle and the leak keeps
-// integrating, which only the forecast sees.
+// integrating, which only the forecast sees. Where kFitAndForecast's fit falls short, the
+// effect may show on held-out data both ways instead: the forecast, and the backcast of the
+// first half by the side identified on the second (docs/diagnose.md, "Shown both ways").
 enum class ShownBy : std::uint8_t { kFitAndForecast, kForecast };
 
 // The best form of leak when it is significant; nullopt otherwise (or when the model or the
