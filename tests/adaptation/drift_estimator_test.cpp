@@ -222,6 +222,33 @@ TEST(DriftEstimator, AHoldWidensTheCovarianceButDoesNotMoveTheEstimate) {
   EXPECT_LT(with_walk, 0.2 + 1e-9);
 }
 
+// The feedforward's scales (feedforward_scales): 1 as identified; at a measured temperature
+// with fitted coefficients, the actuator's response between its linear and loop scales, and
+// its compliance scale.
+TEST(AdaptedReconstruction, TheFeedforwardScalesFollowAMeasuredTemperature) {
+  const Drifted data = drifted(0.0, 0.0, 0.0, 2000, 3);
+  models::TransducerModel m = data.model;
+  AdaptedReconstruction plain(m, DriftEstimatorConfig{});
+  static_cast<void>(plain.step(data.e[1000], data.d[1000]));
+  EXPECT_DOUBLE_EQ(plain.feedforward_scales().response, 1.0);
+  EXPECT_DOUBLE_EQ(plain.feedforward_scales().compliance, 1.0);
+  models::TemperatureCoefficients t{};
+  t.actuator.linear.per_k = 2e-3;
+  t.actuator.loop.per_k = -4e-3;
+  t.actuator.coupling.per_k = 5e-4;
+  m.temperature = t;
+  AdaptedReconstruction rec(m, DriftEstimatorConfig{});
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    rec.set_temperature(45.0);
+    static_cast<void>(rec.step(data.e[k], data.d[k]));
+  }
+  const AdaptedReconstruction::FeedforwardScales g = rec.feedforward_scales();
+  EXPECT_GT(g.response, 1.0 - 0.08 - 1e-12);  // between the loop's 0.92 ...
+  EXPECT_LT(g.response, 1.0 + 0.04 + 1e-12);  // ... and the linear part's 1.04
+  EXPECT_NE(g.response, 1.0);
+  EXPECT_DOUBLE_EQ(g.compliance, 1.0 + 5e-4 * 20.0);
+}
+
 TEST(AdaptedReconstruction, LearnsNothingAcrossSamplesTheLoopRejects) {
   const Drifted data = drifted(0.08, -0.08, 0.04, 4000, 7);
   AdaptedReconstruction plain(data.model, DriftEstimatorConfig{});
