@@ -155,6 +155,7 @@ AdaptedReconstruction::Estimate AdaptedReconstruction::kernel_step(double field,
     models::SideOperator& a = *kernel_.actuator();
     fixed_a = a.offset() + a.quadratic() * field * field;
     pa = actuator_split_->split(a, field, a.step_unloaded(field) - fixed_a);
+    actuator_parts_ = pa;
   }
   // The mount's stress from the stack as identified (header comment), for the model's own D.
   const double mount_stress =
@@ -215,6 +216,17 @@ AdaptedReconstruction::Scales AdaptedReconstruction::scales(const Drift& dr) con
   }
   return {1.0 + dr.permittivity, 1.0 + dr.loop, 1.0 + dr.coupling,
           1.0 + dr.coupling,     1.0 + dr.loop, 1.0 + dr.compliance};
+}
+
+AdaptedReconstruction::FeedforwardScales AdaptedReconstruction::feedforward_scales()
+    const noexcept {
+  if (!kernel_.actuator()) return {};
+  const Scales g = scales(estimator_.drift());
+  const double l = actuator_parts_.linear;
+  const double h = actuator_parts_.loop;
+  const double sum = l + h;
+  if (!(std::abs(sum) > 1e-3 * (std::abs(l) + std::abs(h)))) return {1.0, g.actuator_compliance};
+  return {(g.actuator_linear * l + g.actuator_loop * h) / sum, g.actuator_compliance};
 }
 
 Drift AdaptedReconstruction::drift() const noexcept {

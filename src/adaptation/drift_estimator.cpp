@@ -18,6 +18,7 @@ bool DriftEstimatorConfig::is_valid(const std::string& prefix, std::string* why)
                 {"max_interval_s", max_interval_s},
                 {"memory_updates", memory_updates},
                 {"initial_variance", initial_variance},
+                {"process_noise_per_s", process_noise_per_s},
                 {"max_relative_change", max_relative_change},
                 {"reference_degc", reference_degc},
                 {"permittivity_per_k", permittivity_per_k},
@@ -33,6 +34,7 @@ bool DriftEstimatorConfig::is_valid(const std::string& prefix, std::string* why)
                      check::require(memory_updates > 1.0, key("memory_updates"), memory_updates,
                                     "must be > 1", why) &&
                      check::positive(key("initial_variance"), initial_variance, why) &&
+                     check::non_negative(key("process_noise_per_s"), process_noise_per_s, why) &&
                      check::require(max_relative_change > 0.0 && max_relative_change < 1.0,
                                     key("max_relative_change"), max_relative_change,
                                     "must be within (0, 1)", why) &&
@@ -56,11 +58,13 @@ DriftEstimator::DriftEstimator(const DriftEstimatorConfig& config, double sample
   ts_ = sample_time_s;
   scale_ = 1.0 / (c0 * config_.min_field_step_v_per_m);
   mu_ = 1.0 - 1.0 / config_.memory_updates;
+  growth_ = config_.process_noise_per_s * ts_;
   p_ = {config_.initial_variance, 0.0, 0.0, config_.learn_loop ? config_.initial_variance : 0.0};
 }
 
 bool DriftEstimator::step(double field, double sensed, double linear_part, double loop_part,
                           bool accepted) noexcept {
+  if (!config_.frozen) grow_covariance();
   if (!accepted || !std::isfinite(field) || !std::isfinite(sensed) || !std::isfinite(linear_part) ||
       !std::isfinite(loop_part)) {
     anchored_ = false;
@@ -120,6 +124,18 @@ bool DriftEstimator::step(double field, double sensed, double linear_part, doubl
   p_ = next;
   ++updates_;
   return true;
+}
+
+void DriftEstimator::grow_covariance() noexcept {
+  if (!(growth_ > 0.0)) return;
+  p_[0] += growth_;
+  if (config_.learn_loop) p_[3] += growth_;
+  const double trace = p_[0] + p_[3];
+  const double limit = (config_.learn_loop ? 2.0 : 1.0) * config_.initial_variance;
+  if (trace > limit) {
+    for (double& v : p_)
+      v *= limit / trace;
+  }
 }
 
 Drift DriftEstimator::drift() const noexcept {

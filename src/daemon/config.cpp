@@ -194,6 +194,7 @@ void read_adaptation(YamlMap a, AdaptationSection& out) {
   a.read("max_interval_s", e.max_interval_s);
   a.read("memory_updates", e.memory_updates);
   a.read("initial_variance", e.initial_variance);
+  a.read("process_noise_per_s", e.process_noise_per_s);
   a.read("max_relative_change", e.max_relative_change);
   a.read("reference_degc", e.reference_degc);
   a.read("permittivity_per_k", e.permittivity_per_k);

@@ -137,6 +137,8 @@ const std::array kTable{
               differs<&C::adaptation, &A::estimator, &E::memory_updates>},
     ReloadKey{"adaptation.initial_variance", kRefused,
               differs<&C::adaptation, &A::estimator, &E::initial_variance>},
+    ReloadKey{"adaptation.process_noise_per_s", kRefused,
+              differs<&C::adaptation, &A::estimator, &E::process_noise_per_s>},
     ReloadKey{"adaptation.max_relative_change", kRefused,
               differs<&C::adaptation, &A::estimator, &E::max_relative_change>},
     ReloadKey{"adaptation.reference_degc", kRefused,

@@ -63,9 +63,17 @@ void Controller::swap_feedforward(Feedforward& next) noexcept {
   if (ff_.inverse) ff_.inverse->reset(last_command_);
 }
 
+void Controller::set_feedforward_scales(double response_scale, double compliance_scale) noexcept {
+  const auto sane = [](double g) { return std::isfinite(g) && g >= 0.5 && g <= 2.0 ? g : 1.0; };
+  ff_response_scale_ = sane(response_scale);
+  ff_compliance_scale_ = sane(compliance_scale);
+}
+
 double Controller::feedforward(double strain) noexcept {
   if (!ff_.inverse) return 0.0;
-  const double target = strain - ff_.compliance * ff_stress_ - ff_.strain_offset;
+  const double target =
+      (strain - ff_compliance_scale_ * ff_.compliance * ff_stress_ - ff_.strain_offset) /
+      ff_response_scale_;
   const double e = ff_.inverse->input_for(target);
   return std::isfinite(e) ? std::clamp(e, config_.command_min, config_.command_max) : 0.0;
 }

@@ -328,8 +328,10 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
   sample.t_ref = in.t_ref;
   sample.temp_ref = in.temp_ref;
   sample.driver_status = in.device_status;
+  bool temperature_measured = false;
   if (adapted_ && config_.adaptation_temperature) {
-    if (read == DriverStatus::kOk && std::isfinite(in.temp_ref)) {
+    temperature_measured = read == DriverStatus::kOk && std::isfinite(in.temp_ref);
+    if (temperature_measured) {
       adapted_->set_temperature(in.temp_ref);
     } else {
       adapted_->clear_temperature();
@@ -358,6 +360,14 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
   } else {
     predicted_d_ = adaptation::HealthEstimator::kNoPrediction;
     if (adapted_) adapted_->skip();
+  }
+  // The feedforward follows a measured temperature through the model's fitted coefficients
+  // (the estimate from E and D alone is not fed to it: docs/adaptation.md).
+  if (temperature_measured && adapted_->has_temperature_coefficients()) {
+    const adaptation::AdaptedReconstruction::FeedforwardScales g = adapted_->feedforward_scales();
+    controller_.set_feedforward_scales(g.response, g.compliance);
+  } else {
+    controller_.set_feedforward_scales(1.0, 1.0);
   }
   follow_health(read == DriverStatus::kOk && active_causes_ == 0, in.e, in.d);
   supervisor_.note_cycle(overrun, cycle_, missed);

@@ -188,10 +188,11 @@ void print(const char* what, const Figures& f) {
       f.temperature_rms_k, f.temperature_max_k);
 }
 
-// Measured (seed 21, 25 -> 55 degC over the mix excitation twice, 200 s at 1 kHz):
+// Measured (seed 21, 25 -> 55 degC over the mix excitation twice, 200 s at 1 kHz; the drift's
+// random walk process_noise_per_s 3e-5 since 2026-11-27, docs/adaptation.md):
 //   as identified         S_hat 1.757 % (max 6.16 %), T_hat 5.519 % (max 19.39 %)
-//   adapted (E, D only)   S_hat 0.309 % (max 1.08 %), T_hat 1.120 % (max 3.54 %),
-//                         equivalent temperature 2.66 K RMS, 5.72 K max after the first 20 s
+//   adapted (E, D only)   S_hat 0.274 % (max 0.83 %), T_hat 1.022 % (max 2.81 %),
+//                         equivalent temperature 2.34 K RMS, 5.80 K max after the first 20 s
 //   recorded temperature  S_hat 0.165 % (max 0.63 %), T_hat 0.709 % (max 2.50 %)
 // Issue 24's goal (0.2 % and 0.8 % without the temperature, 0.15 % and 0.6 % with it, 2 K) is
 // not reached with the model alone: the bounds below are the measured figures with a margin of
@@ -209,12 +210,12 @@ TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
   print("recorded temperature", measured);
   RecordProperty("S_hat_nrmse_adapted", std::to_string(adapted.strain.nrmse));
   RecordProperty("T_hat_nrmse_adapted", std::to_string(adapted.stress.nrmse));
-  EXPECT_LE(adapted.strain.nrmse, 0.0040);
-  EXPECT_LE(adapted.strain.max, 0.014);
-  EXPECT_LE(adapted.stress.nrmse, 0.0146);
-  EXPECT_LE(adapted.stress.max, 0.046);
-  EXPECT_LE(adapted.temperature_rms_k, 3.5);
-  EXPECT_LE(adapted.temperature_max_k, 7.4);
+  EXPECT_LE(adapted.strain.nrmse, 0.0036);
+  EXPECT_LE(adapted.strain.max, 0.0108);
+  EXPECT_LE(adapted.stress.nrmse, 0.0133);
+  EXPECT_LE(adapted.stress.max, 0.0365);
+  EXPECT_LE(adapted.temperature_rms_k, 3.05);
+  EXPECT_LE(adapted.temperature_max_k, 7.5);
   EXPECT_LE(measured.strain.nrmse, 0.0021);
   EXPECT_LE(measured.strain.max, 0.0082);
   EXPECT_LE(measured.stress.nrmse, 0.0092);
@@ -226,8 +227,8 @@ TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
   EXPECT_LT(adapted.stress.nrmse, 0.25 * none.stress.nrmse);
   // With the temperature coefficients fitted on the identification excitation's ramp
   // (model_with_coefficients), measured 0.152 % (max 0.57 %) and 0.591 % (max 2.19 %) with the
-  // recorded temperature; 0.208 % (max 0.90 %), 0.690 % (max 2.81 %), 2.39 K RMS, 5.50 K max
-  // adapted from E and D.
+  // recorded temperature; 0.177 % (max 0.75 %), 0.602 % (max 2.33 %), 2.07 K RMS, 5.71 K max
+  // adapted from E and D (0.208 %, 0.690 %, 2.39 K before the random walk).
   print("recorded, fitted coef", fitted);
   print("adapted, fitted coef", adapted_fitted);
   EXPECT_LE(fitted.strain.nrmse, 0.0020);
@@ -235,20 +236,20 @@ TEST(AdaptationAccuracy, WarmingRampWithoutTemperatureInput) {
   EXPECT_LE(fitted.stress.nrmse, 0.0077);
   EXPECT_LE(fitted.stress.max, 0.0285);
   EXPECT_LT(fitted.stress.nrmse, measured.stress.nrmse);
-  EXPECT_LE(adapted_fitted.strain.nrmse, 0.0027);
-  EXPECT_LE(adapted_fitted.strain.max, 0.0117);
-  EXPECT_LE(adapted_fitted.stress.nrmse, 0.0090);
-  EXPECT_LE(adapted_fitted.stress.max, 0.0365);
-  EXPECT_LE(adapted_fitted.temperature_rms_k, 3.1);
-  EXPECT_LE(adapted_fitted.temperature_max_k, 7.2);
+  EXPECT_LE(adapted_fitted.strain.nrmse, 0.0023);
+  EXPECT_LE(adapted_fitted.strain.max, 0.0098);
+  EXPECT_LE(adapted_fitted.stress.nrmse, 0.0078);
+  EXPECT_LE(adapted_fitted.stress.max, 0.0303);
+  EXPECT_LE(adapted_fitted.temperature_rms_k, 2.7);
+  EXPECT_LE(adapted_fitted.temperature_max_k, 7.4);
   EXPECT_LT(adapted_fitted.stress.nrmse, adapted.stress.nrmse);
 }
 
 // Slow random swings about 40 degC (between about 26 and 54 degC, up to 0.5 K/s), the same
-// model and validation plant, 300 s (seed 23). Measured:
+// model and validation plant, 300 s (seed 23). Measured (the random walk on, above):
 //   as identified         S_hat 1.560 % (max 4.85 %), T_hat 4.942 % (max 16.03 %)
-//   adapted (E, D only)   S_hat 0.403 % (max 1.47 %), T_hat 1.383 % (max 4.75 %),
-//                         equivalent temperature 3.84 K RMS, 10.93 K max after the first 20 s
+//   adapted (E, D only)   S_hat 0.333 % (max 1.19 %), T_hat 1.181 % (max 3.85 %),
+//                         equivalent temperature 3.18 K RMS, 10.29 K max after the first 20 s
 //   recorded temperature  S_hat 0.142 % (max 0.61 %), T_hat 0.638 % (max 2.47 %)
 // Asserted at about 1.3x; the goal is not reached without the temperature (docs/adaptation.md).
 TEST(AdaptationAccuracy, SlowRandomSwingsWithoutTemperatureInput) {
@@ -264,21 +265,22 @@ TEST(AdaptationAccuracy, SlowRandomSwingsWithoutTemperatureInput) {
   print("swings, recorded temp", measured);
   print("swings, fitted coef", fitted);
   print("swings, adapted fitted", adapted_fitted);
-  EXPECT_LE(adapted.strain.nrmse, 0.0053);
-  EXPECT_LE(adapted.stress.nrmse, 0.018);
-  EXPECT_LE(adapted.temperature_rms_k, 5.0);
+  EXPECT_LE(adapted.strain.nrmse, 0.0043);
+  EXPECT_LE(adapted.stress.nrmse, 0.0154);
+  EXPECT_LE(adapted.temperature_rms_k, 4.15);
   EXPECT_LE(measured.strain.nrmse, 0.0019);
   EXPECT_LE(measured.stress.nrmse, 0.0083);
   EXPECT_GE(none.stress.nrmse, 0.04);
   EXPECT_LT(adapted.strain.nrmse, 0.35 * none.strain.nrmse);
   EXPECT_LT(adapted.stress.nrmse, 0.35 * none.stress.nrmse);
   // With the fitted coefficients, measured 0.123 % and 0.499 % with the recorded temperature;
-  // 0.341 %, 1.090 %, 3.71 K RMS adapted from E and D.
+  // 0.273 %, 0.889 %, 3.04 K RMS adapted from E and D (0.341 %, 1.090 %, 3.71 K before the
+  // random walk; what the rest is made of: docs/adaptation.md).
   EXPECT_LE(fitted.strain.nrmse, 0.0016);
   EXPECT_LE(fitted.stress.nrmse, 0.0065);
-  EXPECT_LE(adapted_fitted.strain.nrmse, 0.0044);
-  EXPECT_LE(adapted_fitted.stress.nrmse, 0.0142);
-  EXPECT_LE(adapted_fitted.temperature_rms_k, 4.8);
+  EXPECT_LE(adapted_fitted.strain.nrmse, 0.0036);
+  EXPECT_LE(adapted_fitted.stress.nrmse, 0.0116);
+  EXPECT_LE(adapted_fitted.temperature_rms_k, 3.95);
 }
 
 // A 10-minute hold after the ramp (the field held at 1 MV/m, the load still moving, 55 degC):

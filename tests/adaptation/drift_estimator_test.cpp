@@ -67,6 +67,10 @@ TEST(DriftEstimatorConfig, NamesTheViolatedKey) {
   EXPECT_FALSE(c.is_valid("adaptation.", &why));
   EXPECT_EQ(why, "adaptation.memory_updates: 1 must be > 1");
   c = DriftEstimatorConfig{};
+  c.process_noise_per_s = -1e-5;
+  EXPECT_FALSE(c.is_valid("adaptation.", &why));
+  EXPECT_EQ(why.rfind("adaptation.process_noise_per_s: ", 0), 0U) << why;
+  c = DriftEstimatorConfig{};
   c.permittivity_per_k = 0.0;
   EXPECT_FALSE(c.is_valid("adaptation.", &why));
   EXPECT_EQ(why, "adaptation.permittivity_per_k: 0 must not be 0");
@@ -182,6 +186,69 @@ TEST(DriftEstimator, LearnsNothingOnHoldsRejectedSamplesOrWhenFrozen) {
 // The loop's own rejections (runtime/loop.hpp): a sample estimated with learn = false and a
 // sample skipped (a driver fault) each leave the estimator without an anchor, so no increment
 // spans them; the same field steps without them update every time.
+// The drift's random walk (process_noise_per_s): on a hold the estimate does not move at all,
+// but the first updates after it weigh more, so a change that happened during the hold is found
+// in fewer updates than with the forgetting alone; a large step's update (50 gate steps) does
+// not leave it stiff.
+TEST(DriftEstimator, AHoldWidensTheCovarianceButDoesNotMoveTheEstimate) {
+  const auto learn = [](DriftEstimator& est, double gain, int updates) {
+    for (int k = 0; k < updates; ++k) {
+      const double e = 1e6 + 1e5 * (k % 2);
+      est.step(e, 0.03 + gain * e, 2e-8 * e, 0.01, true);
+    }
+  };
+  const auto after_hold = [&learn](double process_noise) {
+    DriftEstimatorConfig c{};
+    c.process_noise_per_s = process_noise;
+    DriftEstimator est(c, kTs, 2e-8);
+    learn(est, 2.2e-8, 5000);          // epsilon 0.1, ending at 1.1e6 V/m
+    const auto hold = [&est](int k) {  // a 10 s hold at 1e6 V/m, over which the stack warms
+      const double e = 1e6 + 100.0 * std::sin(k);
+      return est.step(e, 0.03 + 2.4e-8 * e, 2e-8 * e, 0.01, true);
+    };
+    EXPECT_TRUE(hold(0));  // the step onto the hold is an update
+    const Drift before = est.drift();
+    for (int k = 1; k < 100000; ++k)
+      EXPECT_FALSE(hold(k));
+    EXPECT_EQ(est.drift().permittivity, before.permittivity);
+    learn(est, 2.4e-8, 20);  // epsilon 0.2 from then on
+    return est.drift().permittivity;
+  };
+  const double with_walk = after_hold(3e-5);
+  const double without = after_hold(0.0);
+  std::printf("20 updates after a 10 s hold: epsilon %.4f with the random walk, %.4f without\n",
+              with_walk, without);
+  EXPECT_GT(with_walk - 0.1, 2.0 * (without - 0.1));
+  EXPECT_LT(with_walk, 0.2 + 1e-9);
+}
+
+// The feedforward's scales (feedforward_scales): 1 as identified; at a measured temperature
+// with fitted coefficients, the actuator's response between its linear and loop scales, and
+// its compliance scale.
+TEST(AdaptedReconstruction, TheFeedforwardScalesFollowAMeasuredTemperature) {
+  const Drifted data = drifted(0.0, 0.0, 0.0, 2000, 3);
+  models::TransducerModel m = data.model;
+  AdaptedReconstruction plain(m, DriftEstimatorConfig{});
+  static_cast<void>(plain.step(data.e[1000], data.d[1000]));
+  EXPECT_DOUBLE_EQ(plain.feedforward_scales().response, 1.0);
+  EXPECT_DOUBLE_EQ(plain.feedforward_scales().compliance, 1.0);
+  models::TemperatureCoefficients t{};
+  t.actuator.linear.per_k = 2e-3;
+  t.actuator.loop.per_k = -4e-3;
+  t.actuator.coupling.per_k = 5e-4;
+  m.temperature = t;
+  AdaptedReconstruction rec(m, DriftEstimatorConfig{});
+  for (std::size_t k = 0; k < data.e.size(); ++k) {
+    rec.set_temperature(45.0);
+    static_cast<void>(rec.step(data.e[k], data.d[k]));
+  }
+  const AdaptedReconstruction::FeedforwardScales g = rec.feedforward_scales();
+  EXPECT_GT(g.response, 1.0 - 0.08 - 1e-12);  // between the loop's 0.92 ...
+  EXPECT_LT(g.response, 1.0 + 0.04 + 1e-12);  // ... and the linear part's 1.04
+  EXPECT_NE(g.response, 1.0);
+  EXPECT_DOUBLE_EQ(g.compliance, 1.0 + 5e-4 * 20.0);
+}
+
 TEST(AdaptedReconstruction, LearnsNothingAcrossSamplesTheLoopRejects) {
   const Drifted data = drifted(0.08, -0.08, 0.04, 4000, 7);
   AdaptedReconstruction plain(data.model, DriftEstimatorConfig{});

@@ -465,6 +465,33 @@ TEST(Loop, AModelIsSwappedOnlyWhileDisarmedWithItsFeedforward) {
   EXPECT_NEAR(s.s_hat, 8e-4, 2e-5);  // 2 % of the setpoint: tracking on the new model
 }
 
+// The feedforward with the stack's drift (Controller::set_feedforward_scales, fed by the loop
+// from a measured temperature): the inverse sees the target divided by the response scale, so
+// the command for strain S at scale 1.1 is the unscaled command for y0 + (S - y0) / 1.1; an
+// insane scale is taken as 1.
+TEST(Controller, TheFeedforwardDividesItsTargetByTheDriftedResponse) {
+  const models::TransducerModel& model = bench_model();
+  ControllerConfig c = bench_control();
+  c.mode = ControlMode::kOpenLoop;
+  c.position_shaper.slew_rate = 0.0;
+  const double y0 = model.actuator->offset;
+  const auto command = [&](double strain, double response_scale) {
+    Controller ctl(c, model.actuator, kTs);
+    ctl.arm(strain, 0.0, 0.0);
+    ctl.set_feedforward_scales(response_scale, 1.0);
+    double u = 0.0;
+    for (int k = 0; k < 10; ++k)
+      u = ctl.step(strain, strain, 0.0);
+    return u;
+  };
+  const double strain = 6e-4;
+  const double scaled = command(strain, 1.1);
+  EXPECT_NEAR(scaled, command(y0 + (strain - y0) / 1.1, 1.0), 1e-6 * scaled);
+  EXPECT_LT(scaled, command(strain, 1.0));
+  EXPECT_EQ(command(strain, 3.0), command(strain, 1.0));
+  EXPECT_EQ(command(strain, std::nan("")), command(strain, 1.0));
+}
+
 TEST(Loop, OverrunPolicyAndWatchdogFault) {
   LoopConfig lc;
   lc.overrun = {3, 5, 100};

@@ -145,6 +145,17 @@ class AdaptedReconstruction final {
   [[nodiscard]] const models::StatusCounts& counts() const noexcept { return counts_; }
   [[nodiscard]] bool has_strain() const noexcept { return kernel_.actuator().has_value(); }
 
+  // The feedforward's scales at the last sample (runtime::Controller::set_feedforward_scales):
+  // with the actuator's split L_a, H_a there and the scales of the header comment,
+  //   response = (gL_a L_a + gH_a H_a) / (L_a + H_a),   compliance = gc_a
+  // the drifted actuator's operator response over the identified one, the inverse's input
+  // scale; {1, 1} without an actuator side or where |L_a + H_a| is below 1e-3 of |L_a| + |H_a|.
+  struct FeedforwardScales {
+    double response{1.0};
+    double compliance{1.0};
+  };
+  [[nodiscard]] FeedforwardScales feedforward_scales() const noexcept;
+
   // The thermal model, when it is on.
   [[nodiscard]] const std::optional<ThermalModel>& thermal() const noexcept { return thermal_; }
 
@@ -185,8 +196,9 @@ class AdaptedReconstruction final {
   Estimate last_{};
   models::StatusCounts counts_{};
   models::ModelIdentity identity_{};
-  double mount_ratio_{0.0};  // r
-  double mount_kappa_{0.0};  // r / s_a [Pa per unit strain]
+  SideSplit::Parts actuator_parts_{};  // L_a, H_a at the last sample
+  double mount_ratio_{0.0};            // r
+  double mount_kappa_{0.0};            // r / s_a [Pa per unit strain]
   std::optional<models::TemperatureCoefficients> coefficients_{};
   double measured_degc_{kNoTemperature};  // kNoTemperature: none
 };

@@ -29,8 +29,13 @@
 // covariance wind-up on holds):
 //   K = P phi / (mu + phi' P phi),   theta += K (z - phi' theta),   P = (P - K phi' P) / mu
 // then theta is clamped to +-max_relative_change and P scaled back to trace <= p0 per
-// parameter. phi and z are divided by c0 min_field_step_v_per_m (a smallest update's capacitive
-// increment, c0 the model's linear weight), so they are dimensionless and about 1.
+// parameter. The drift is a random walk in time: every sample that is not frozen adds
+// process_noise_per_s Ts to the diagonal of P (bounded the same way), held or moving, so the
+// estimate itself never moves on a hold but the first updates after it weigh more; without
+// it a large step's update (one increment of 50 gate steps) shrank P fifty-fold and the
+// estimate stayed stiff for the next 20 s (docs/adaptation.md, "What the error is made of"). phi
+// and z are divided by c0 min_field_step_v_per_m (a smallest update's capacitive increment, c0 the
+// model's linear weight), so they are dimensionless and about 1.
 //
 // Between updates the estimate can be carried along a predicted temperature change (carry():
 // the thermal model of thermal_model.hpp, a known input of the drift's process model):
@@ -62,7 +67,10 @@ struct DriftEstimatorConfig {
   double max_interval_s{0.05};            // longest anchor-to-update interval [s]
   double memory_updates{500.0};           // forgetting: mu = 1 - 1 / memory_updates
   double initial_variance{1.0};           // p0: P = p0 I at the start [1]
-  double max_relative_change{0.5};        // bound on |epsilon| and |lambda| [1]
+  // The drift's random walk: added to P's diagonal per second of samples, frozen excepted
+  // [1/s] (0: off). Chosen on the fitting ramp (docs/adaptation.md).
+  double process_noise_per_s{3.0e-5};
+  double max_relative_change{0.5};  // bound on |epsilon| and |lambda| [1]
   // The temperature coefficients the drift is read with (config/plant/temperature.yaml):
   double reference_degc{25.0};        // the model's identification temperature [degC]
   double permittivity_per_k{4.0e-3};  // [1/K], must not be 0
@@ -76,8 +84,8 @@ struct DriftEstimatorConfig {
   // adapted_reconstruction.hpp runs it). Off by default: the estimate holds between updates.
   ThermalModelConfig thermal{};
 
-  // Every value finite; steps, intervals, memory > 1, variance, bound positive;
-  // permittivity_per_k non-zero; load_stiffness_ratio >= 0; the thermal model's keys
+  // Every value finite; steps, intervals, memory > 1, variance, bound positive; process noise
+  // >= 0; permittivity_per_k non-zero; load_stiffness_ratio >= 0; the thermal model's keys
   // (thermal_model.hpp) when it is enabled. *why names the key under `prefix`
   // ("adaptation.memory_updates: must be > 1").
   [[nodiscard]] bool is_valid(const std::string& prefix, std::string* why) const;
@@ -130,10 +138,12 @@ class DriftEstimator final {
  private:
   // theta (2), P (4), anchor E, D, L, H, anchor age, anchored, updates.
   static constexpr std::size_t kStateSize{13};
+  void grow_covariance() noexcept;  // the random walk's share of one sample
 
   DriftEstimatorConfig config_;
   double ts_{0.0};
-  double scale_{1.0};  // 1 / (c0 min_field_step)
+  double growth_{0.0};  // process_noise_per_s Ts
+  double scale_{1.0};   // 1 / (c0 min_field_step)
   double mu_{1.0};
   std::array<double, 2> theta_{};
   std::array<double, 4> p_{};  // row major

@@ -38,8 +38,9 @@
 //     enabled: false                    # true: the loop runs adaptation::AdaptedReconstruction
 //     frozen: false                     # start with learning frozen (ctl adapt resume)
 //     learn_loop, min_field_step_v_per_m, max_interval_s, memory_updates, initial_variance,
-//     max_relative_change, reference_degc, permittivity_per_k, loop_per_k, coupling_per_k,
-//     compliance_per_k, load_stiffness_ratio   # adaptation::DriftEstimatorConfig's keys
+//     process_noise_per_s, max_relative_change, reference_degc, permittivity_per_k,
+//     loop_per_k, coupling_per_k, compliance_per_k,
+//     load_stiffness_ratio              # adaptation::DriftEstimatorConfig's keys
 //     use_temperature: false            # true: the driver's temp replaces the estimate
 //   health:                             # health from E and D, alarms (docs/health.md)
 //     enabled: false                    # true: the loop runs adaptation::HealthEstimator

@@ -114,6 +114,13 @@ class Controller final {
   // plays cannot be carried over to other thresholds. No allocation (moves only).
   void swap_feedforward(Feedforward& next) noexcept;
   [[nodiscard]] std::size_t saturations() const noexcept { return saturations_; }
+  // The stack's drift for the feedforward (adaptation::AdaptedReconstruction::
+  // feedforward_scales(): the actuator's operator response and compliance at the measured
+  // temperature over their values as identified). The inverse is applied to
+  //   (strain - compliance_scale s T_arm - y0) / response_scale
+  // so the drifted actuator, response_scale times the identified operator, reaches the strain.
+  // A scale that is not finite or outside [0.5, 2] is taken as 1. Real-time safe.
+  void set_feedforward_scales(double response_scale, double compliance_scale) noexcept;
 
  private:
   double feedforward(double strain) noexcept;
@@ -130,6 +137,8 @@ class Controller final {
   std::optional<control::DampingController> damping_{};
   Feedforward ff_{};       // the inverse's memory follows the applied E
   double ff_stress_{0.0};  // T_hat at arm: the feedforward's static load
+  double ff_response_scale_{1.0};
+  double ff_compliance_scale_{1.0};
   double shaped_{0.0};
   double last_command_{0.0};
   std::size_t saturations_{0};
