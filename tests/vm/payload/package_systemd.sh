@@ -11,7 +11,7 @@
 # Enabled and started, reset and armed through the installed `selfsense ctl`, a recording under
 # /var/lib/selfsensed, a clean `systemctl stop`; `apt-get remove` stops the running service,
 # `apt-get purge` removes the configuration and the state. Runs after daemon_systemd, whose
-# hand-installed unit and configuration it removes first. Prints "name=value" lines that
+# install of this build's package it purges first. Prints "name=value" lines that
 # tests/vm/package_systemd.sh checks.
 set -euo pipefail
 
@@ -29,11 +29,12 @@ prop() { systemctl show -p "$1" --value "$unit"; }
 ctl() { /usr/bin/selfsense ctl "$@"; }
 field() { sed -n "s/.*\"$1\":\"\\([a-z]*\\)\".*/\\1/p"; }
 
-# What daemon_systemd installed by hand.
-systemctl stop "$unit" 2>/dev/null || true
-rm -rf "/etc/systemd/system/$unit" "/etc/systemd/system/$unit.d" /etc/selfsense /var/lib/selfsensed \
-  /usr/local/bin/selfsensed
-systemctl daemon-reload
+# What daemon_systemd installed (this build's package, its configuration changed): purged, so
+# that the previous version installs afresh (apt does not downgrade).
+if dpkg-query -W -f='${Status}' selfsense 2>/dev/null | grep -q 'install ok installed'; then
+  apt-get -q -y -o Dpkg::Use-Pty=0 purge selfsense >/tmp/apt-purge-before.log 2>&1 ||
+    { tail -20 /tmp/apt-purge-before.log; fail "apt-get purge (daemon_systemd's install)"; }
+fi
 systemctl reset-failed "$unit" 2>/dev/null || true
 
 arch=$(dpkg --print-architecture)
