@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
-# Inside the VM, under systemd as PID 1: this build's selfsense Debian package installed with apt
-# from /payload/files/packages (offline: the image holds its Depends), run as it ships: the unit
+# Inside the VM, under systemd as PID 1: the selfsense Debian package installed with apt from
+# /payload/files/packages (offline: the image holds its Depends), run as it ships: the unit
 # from /lib/systemd/system (ExecStart /usr/bin/selfsensed), the user from sysusers.d, the
 # packaged /etc/selfsense/selfsensed.yaml on the simulated transducer with the emulation's
-# tolerances put in. Checks that `systemd-analyze verify` accepts the unit, that the service is
-# active once it sent READY=1, that it keeps itself alive through the watchdog, that a frozen
-# daemon gets restarted by the watchdog, that a kill -9 of an armed daemon restarts it faulted,
-# and that `systemctl stop` ends it with status 0 after its safe-output shutdown. Leaves the
-# package installed (package_systemd purges it before its own install).
+# tolerances put in (the administrator's change). The package is this build's as the previous
+# version (packages/previous/, VERSION~prev: the same files) when the boot brought one, so that
+# package_systemd upgrades from this install instead of installing again; else this build's.
+# Checks that `systemd-analyze verify` accepts the unit, that the service is active once it
+# sent READY=1, that it keeps itself alive through the watchdog, that a frozen daemon gets
+# restarted by the watchdog, that a kill -9 of an armed daemon restarts it faulted, and that
+# `systemctl stop` ends it with status 0 after its safe-output shutdown.
 # Prints "name=value" lines that tests/vm/daemon_systemd.sh checks.
 set -euo pipefail
 
@@ -24,7 +26,8 @@ fail() {
 prop() { systemctl show -p "$1" --value "$unit"; }
 
 arch=$(dpkg --print-architecture)
-deb=$(ls /payload/files/packages/selfsense_*_"$arch".deb 2>/dev/null | head -1 || true)
+deb=$(ls /payload/files/packages/previous/selfsense_*_"$arch".deb /payload/files/packages/selfsense_*_"$arch".deb \
+  2>/dev/null | head -1 || true)
 [ -n "$deb" ] || fail "no selfsense package in /payload/files/packages (tests/vm/boot.sh --packages)"
 apt-get -q -y -o Dpkg::Use-Pty=0 install "$deb" >/tmp/apt-install-daemon.log 2>&1 ||
   { tail -20 /tmp/apt-install-daemon.log; fail "apt-get install $deb"; }
