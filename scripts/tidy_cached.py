@@ -6,7 +6,13 @@ Usage: tidy_cached.py BUILD_DIR REGEX [JOBS]
 A unit is skipped when the same clang-tidy, the same .clang-tidy files, the same compile command
 and the same preprocessed source (every header it includes, the source root written as @ROOT@ so
 a clone elsewhere hits too) were found clean before. Only clean results are cached: a unit with a
-finding runs again next time. Cache: $SELFSENSE_TIDY_CACHE, else /var/cache/selfsense-tidy when
+finding runs again next time.
+
+Two keys name the same unit: the preprocessed source's, and (as ccache's direct mode) the
+contents of the files the build's compiler read for it (Ninja's dependency log, `ninja -t deps`),
+used only when the unit's object is newer than every one of them (the build is up to date for
+it). The second needs no preprocessor: a run in which nothing changed reads files instead of
+preprocessing every unit. A unit found clean under either key gets both stamps. Cache: $SELFSENSE_TIDY_CACHE, else /var/cache/selfsense-tidy when
 writable, else BUILD_DIR/tidy-cache. Exit 1 when any unit has a finding (its output is printed).
 """
 import concurrent.futures
@@ -50,6 +56,31 @@ def preprocess_command(entry):
     return out + ["-E", "-P", "-o", "-"]
 
 
+def ninja_deps(build):
+    """{object path relative to BUILD: [dependency paths as Ninja wrote them]} from Ninja's log."""
+    run = subprocess.run(["ninja", "-C", build, "-t", "deps"], capture_output=True, text=True)
+    deps, current = {}, None
+    if run.returncode != 0:
+        return deps
+    for line in run.stdout.splitlines():
+        if not line.startswith(" ") and "#deps" in line:
+            target, rest = line.split(": #deps", 1)
+            current = [] if rest.rstrip().endswith("(VALID)") else None
+            if current is not None:
+                deps[target] = current
+        elif line.strip() and current is not None:
+            current.append(line.strip())
+    return deps
+
+
+def object_of(entry):
+    args = entry["arguments"] if "arguments" in entry else shlex.split(entry["command"])
+    for i, a in enumerate(args[:-1]):
+        if a == "-o":
+            return args[i + 1]
+    return None
+
+
 def main():
     build, pattern = sys.argv[1], re.compile(sys.argv[2])
     jobs = int(sys.argv[3]) if len(sys.argv) > 3 else os.cpu_count() or 1
@@ -69,17 +100,57 @@ def main():
         with open(path, "rb") as f:
             config += os.path.relpath(path, root).encode() + b"\0" + f.read()
     root_bytes = root.encode()
+    deps = ninja_deps(build)
+    digests = {}  # path -> (mtime_ns, sha256 of its content); threads may fill it twice, harmlessly
+
+    def digest(path):
+        st = os.stat(path)
+        known = digests.get(path)
+        if known and known[0] == st.st_mtime_ns:
+            return known
+        with open(path, "rb") as f:
+            known = (st.st_mtime_ns, hashlib.sha256(f.read()).digest())
+        digests[path] = known
+        return known
+
+    def direct_stamp(entry, command):
+        """The unit's stamp from the files its compiler read, or None when unknown or stale."""
+        obj = object_of(entry)
+        if obj is None:
+            return None
+        obj_path = os.path.normpath(os.path.join(entry["directory"], obj))
+        listed = deps.get(os.path.relpath(obj_path, os.path.abspath(build)))
+        if not listed:
+            return None
+        try:
+            built = os.stat(obj_path).st_mtime_ns
+            key = hashlib.sha256(b"direct\0" + version + config + command)
+            for dep in listed:
+                path = os.path.normpath(os.path.join(os.path.abspath(build), dep))
+                mtime, content = digest(path)
+                if mtime > built:
+                    return None  # changed since the build: its includes may have too
+                key.update(path.encode().replace(root_bytes, b"@ROOT@") + b"\0" + content)
+        except OSError:
+            return None
+        return os.path.join(cache, key.hexdigest())
 
     def check(entry):
+        command = " ".join(preprocess_command(entry)).encode().replace(root_bytes, b"@ROOT@")
+        direct = direct_stamp(entry, command)
+        if direct and os.path.exists(direct):
+            return "cached", ""
         pre = subprocess.run(preprocess_command(entry), cwd=entry["directory"],
                              capture_output=True)
         key = hashlib.sha256(version + config)
         if pre.returncode == 0:
-            command = " ".join(preprocess_command(entry)).encode()
-            key.update(command.replace(root_bytes, b"@ROOT@"))
+            key.update(command)
             key.update(pre.stdout.replace(root_bytes, b"@ROOT@"))
             stamp = os.path.join(cache, key.hexdigest())
             if os.path.exists(stamp):
+                if direct:
+                    with open(direct, "w", encoding="utf-8"):
+                        pass
                 return "cached", ""
         else:
             stamp = None  # not preprocessable here: always checked
@@ -89,9 +160,10 @@ def main():
         clean = run.returncode == 0 and not re.search(r"(warning|error):", output)
         if not clean:
             return "finding", output or f"clang-tidy exited {run.returncode}"
-        if stamp:
-            with open(stamp, "w", encoding="utf-8"):
-                pass
+        for path in (stamp, direct):
+            if path:
+                with open(path, "w", encoding="utf-8"):
+                    pass
         return "checked", ""
 
     counts = {"cached": 0, "checked": 0, "finding": 0}

@@ -1,12 +1,21 @@
 #!/usr/bin/env bash
-# Inside the VM, under systemd as PID 1: selfsensed installed with its unit
-# (systemd/selfsensed.service) and a configuration like config/selfsensed.yaml. Checks that
-# `systemd-analyze verify` accepts the unit, that the service is active once it sent READY=1,
-# that it keeps itself alive through the watchdog, that a frozen daemon gets restarted by the
-# watchdog, that a kill -9 of an armed daemon restarts it faulted, and that `systemctl stop` ends it with status 0 after its safe-output shutdown.
+# Inside the VM, under systemd as PID 1: the selfsense Debian package installed with apt from
+# /payload/files/packages (offline: the image holds its Depends), run as it ships: the unit
+# from /lib/systemd/system (ExecStart /usr/bin/selfsensed), the user from sysusers.d, the
+# packaged /etc/selfsense/selfsensed.yaml on the simulated transducer with the emulation's
+# tolerances put in (the administrator's change). The package is this build's as the previous
+# version (packages/previous/, VERSION~prev: the same files) when the boot brought one, so that
+# package_systemd upgrades from this install instead of installing again; else this build's.
+# Checks that `systemd-analyze verify` accepts the unit, that the service is active once it
+# sent READY=1, that it keeps itself alive through the watchdog, that a frozen daemon gets
+# restarted by the watchdog, that a kill -9 of an armed daemon restarts it faulted, and that
+# `systemctl stop` ends it with status 0 after its safe-output shutdown.
 # Prints "name=value" lines that tests/vm/daemon_systemd.sh checks.
 set -euo pipefail
 
+# The installed programs with Debian's libraries, not the payload's.
+unset LD_LIBRARY_PATH
+export PATH=/usr/sbin:/usr/bin:/sbin:/bin DEBIAN_FRONTEND=noninteractive
 unit=selfsensed.service
 fail() {
   echo "FAILED: $*"
@@ -16,39 +25,37 @@ fail() {
 }
 prop() { systemctl show -p "$1" --value "$unit"; }
 
-files=/payload/files
-[ -x /payload/bin/selfsensed ] || fail "/payload/bin/selfsensed missing"
-id selfsense >/dev/null 2>&1 || useradd --system --no-create-home --shell /usr/sbin/nologin selfsense
-mkdir -p /etc/selfsense/models /etc/selfsense/plant
-cp "$files/config/models/sim.yaml" /etc/selfsense/models/
-cp "$files/config/plant/daemon.yaml" /etc/selfsense/plant/
+arch=$(dpkg --print-architecture)
+deb=$(ls /payload/files/packages/previous/selfsense_*_"$arch".deb /payload/files/packages/selfsense_*_"$arch".deb \
+  2>/dev/null | head -1 || true)
+[ -n "$deb" ] || fail "no selfsense package in /payload/files/packages (tests/vm/boot.sh --packages)"
+apt-get -q -y -o Dpkg::Use-Pty=0 install "$deb" >/tmp/apt-install-daemon.log 2>&1 ||
+  { tail -20 /tmp/apt-install-daemon.log; fail "apt-get install $deb"; }
+echo "installed=$(dpkg-query -W -f='${Version} ${Status}' selfsense)"
+echo "unit_path=$(prop FragmentPath)"
+echo "exec_start=$(prop ExecStart | sed -n 's/.*path=\([^ ;]*\).*/\1/p')"
+# A first install starts nothing (postinst only restarts a running service on an upgrade).
+echo "is-active_after_install=$(systemctl is-active "$unit" || true)"
+
 # Software emulation is far from real time: a 1 kHz loop, degraded timing allowed, overruns
-# tolerated, also as faults, so that the loop can be armed (this test is about systemd, not timing).
-sed -e 's/rate_hz: 10000/rate_hz: 1000/' -e 's/frequency_hz: 2000.0/frequency_hz: 300.0/' \
+# tolerated, also as faults, so that the loop can be armed (this test is about systemd, not
+# timing). The administrator's edit of the conffile.
+cfg=/etc/selfsense/selfsensed.yaml
+sed -i -e 's/rate_hz: 10000/rate_hz: 1000/' -e 's/frequency_hz: 2000.0/frequency_hz: 300.0/' \
   -e 's/allow_degraded_timing: false/allow_degraded_timing: true/' \
   -e 's/^  overrun: {consecutive: 3, within_count: 10, window_cycles: 10000}$/  overrun: {consecutive: 1000000, within_count: 0}/' \
-  "$files/config/selfsensed.yaml" >/etc/selfsense/selfsensed.yaml
-grep -q '^  overrun: {consecutive: 1000000' /etc/selfsense/selfsensed.yaml ||
-  fail "config/selfsensed.yaml's overrun policy changed: this test's tolerance was not put in"
-selfsense check-config /etc/selfsense/selfsensed.yaml || fail "check-config rejected the configuration"
+  "$cfg"
+grep -q '^  overrun: {consecutive: 1000000' "$cfg" ||
+  fail "the packaged selfsensed.yaml's overrun policy changed: this test's tolerance was not put in"
+selfsense check-config "$cfg" || fail "check-config rejected the configuration"
 
-install -m 0755 /payload/bin/selfsensed /usr/local/bin/selfsensed
-install -m 0644 "$files/selfsensed.service" "/etc/systemd/system/$unit"
-mkdir -p "/etc/systemd/system/$unit.d"
-# The host-built binary's libraries live under /payload/lib.
-cat >"/etc/systemd/system/$unit.d/payload.conf" <<'CFG'
-[Service]
-Environment=LD_LIBRARY_PATH=/payload/lib
-CFG
-if verify=$(systemd-analyze verify "/etc/systemd/system/$unit" 2>&1); then
+if verify=$(systemd-analyze verify "/lib/systemd/system/$unit" 2>&1); then
   echo "verify=ok"
 else
   echo "verify=failed"
   awk '{ print "verify: " $0 }' <<<"$verify"
 fi
 systemd-analyze security --no-pager "$unit" 2>/dev/null | tail -1 | sed 's/^/security: /' || true
-systemctl daemon-reload
-
 systemctl start "$unit" || fail "systemctl start failed"
 state=$(systemctl is-active "$unit" || true)
 echo "is-active=$state"

@@ -11,8 +11,8 @@
 # Enabled and started, reset and armed through the installed `selfsense ctl`, a recording under
 # /var/lib/selfsensed, a clean `systemctl stop`; `apt-get remove` stops the running service,
 # `apt-get purge` removes the configuration and the state. Runs after daemon_systemd, whose
-# hand-installed unit and configuration it removes first. Prints "name=value" lines that
-# tests/vm/package_systemd.sh checks.
+# install of the previous version (its configuration changed the same way) it upgrades.
+# Prints "name=value" lines that tests/vm/package_systemd.sh checks.
 set -euo pipefail
 
 # The installed programs with Debian's libraries, not the payload's.
@@ -29,11 +29,6 @@ prop() { systemctl show -p "$1" --value "$unit"; }
 ctl() { /usr/bin/selfsense ctl "$@"; }
 field() { sed -n "s/.*\"$1\":\"\\([a-z]*\\)\".*/\\1/p"; }
 
-# What daemon_systemd installed by hand.
-systemctl stop "$unit" 2>/dev/null || true
-rm -rf "/etc/systemd/system/$unit" "/etc/systemd/system/$unit.d" /etc/selfsense /var/lib/selfsensed \
-  /usr/local/bin/selfsensed
-systemctl daemon-reload
 systemctl reset-failed "$unit" 2>/dev/null || true
 
 arch=$(dpkg --print-architecture)
@@ -47,14 +42,14 @@ since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
 begin=$(now)
 
 # The administrator's change to the conffile. Software emulation is far from real time: the
-# same tolerances as daemon_systemd.
+# same tolerances as daemon_systemd (which may have put them in already), and a line of its own.
 cfg=/etc/selfsense/selfsensed.yaml
 change_config() {
   sed -i -e 's/rate_hz: 10000/rate_hz: 1000/' -e 's/frequency_hz: 2000.0/frequency_hz: 300.0/' \
     -e 's/allow_degraded_timing: false/allow_degraded_timing: true/' \
     -e 's/^  overrun: {consecutive: 3, within_count: 10, window_cycles: 10000}$/  overrun: {consecutive: 1000000, within_count: 0}/' \
     "$cfg"
-  echo "# changed on this board" >>"$cfg"
+  grep -q '^# changed on this board$' "$cfg" || echo "# changed on this board" >>"$cfg"
   grep -q '^  overrun: {consecutive: 1000000' "$cfg" || fail "the packaged selfsensed.yaml's overrun policy changed"
   selfsense check-config "$cfg" || fail "check-config rejected the changed configuration"
 }
@@ -64,8 +59,16 @@ change_config() {
 # question when the package's own copy did not change), the running service is restarted on the
 # new programs (postinst: try-restart).
 install_and_upgrade() {
-  apt_get install "$previous" >/tmp/apt-install-previous.log 2>&1 ||
-    { tail -20 /tmp/apt-install-previous.log; fail "apt-get install $previous"; }
+  local installed
+  installed=$(dpkg-query -W -f='${Version} ${Status}' selfsense 2>/dev/null || true)
+  if [ "$installed" = "$(dpkg-deb -f "$previous" Version) install ok installed" ]; then
+    echo "previous_installed_by=daemon_systemd"  # the same package, its test run on it
+  else
+    [ -z "$installed" ] || [[ $installed == *" not-installed" ]] || [[ $installed == *" config-files" ]] ||
+      fail "selfsense $installed is installed, not the previous version"
+    apt_get install "$previous" >/tmp/apt-install-previous.log 2>&1 ||
+      { tail -20 /tmp/apt-install-previous.log; fail "apt-get install $previous"; }
+  fi
   echo "previous=$(dpkg-query -W -f='${Version} ${Status}' selfsense)"
   change_config
   systemctl enable --now "$unit" >/dev/null 2>&1 || fail "systemctl enable --now (previous version) failed"
