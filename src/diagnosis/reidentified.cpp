@@ -294,8 +294,6 @@ Trial best_of(const Judge& judge, const std::vector<models::ChannelCorrection>& 
   return best;
 }
 
-// `best` judged against `null` by forecast_explains; the side re-identified on the whole
-// record with it.
 // The effect's backcast against the null's by the rules of a round: each side identified on
 // the second half by its judge (backcast_rows).
 bool shown_backwards(const Judge& null_judge, const models::ChannelCorrection& null_effect,
@@ -329,6 +327,8 @@ std::optional<double> held_out_explains(const Judge& null_judge, const Trial& nu
   return explains;
 }
 
+// `best` judged against `null` by held_out_explains; the side re-identified on the whole record
+// with it.
 std::optional<Reidentified> judged(const Judge& judge, const ChannelData& ch, const Trial& null,
                                    const Trial& best, const Options& options, ShownBy evidence) {
   const std::optional<double> explains =
