@@ -161,7 +161,10 @@ void SocketAbuse::run(std::uint32_t seed) {
           // Sized to the status reply: the server keeps at most 256 KiB of unread replies per
           // client (control_server.hpp, max_output_bytes) and drops a client past that, so the
           // whole flood stays within half of it (a status with fault details is a few KiB).
-          const std::string first = c.exchange(kStatus);
+          // A refused client may be closed before its request is sent: what the server said
+          // first is still there to read (send_lenient).
+          send_lenient(c, std::string(kStatus) + "\n");
+          const std::string first = c.receive_line();
           if (refused(first)) {
             busy();
             break;
