@@ -219,6 +219,17 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
           reidentified_creep_and_leak(model, s, ch, model_output, options);
       if (pair) search_again(pair->reidentified, {pair->leak});
     }
+    // A moving load bends a base identified under it the same way (its loop follows the
+    // stress): where the rounds named the stress dependence on a side nothing re-identified,
+    // the side is re-identified with the stress's terms undone, as for the temperature.
+    const bool named_stress = std::any_of(found.begin(), found.end(), [](const Finding& f) {
+      return f.effect == "stress_dependence";
+    });
+    if (!reidentified && named_stress) {
+      std::optional<Reidentified> loaded =
+          reidentified_stress_terms(model, s, ch, model_output, options);
+      if (loaded) search_again(*loaded, {});
+    }
     // A channel sampled late bends the base the same way (its fastest lags follow the lag, so a
     // delay fitted after it wins on fast blocks and loses on slow ones): where a lag explained
     // min_explains of the held-out residual in the first round and the rounds named nothing

@@ -180,4 +180,13 @@ namespace selfsense::diagnosis::detail {
     const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
     const std::vector<double>& current, const Options& options);
 
+// Stress dependence the same way: the channel's side and the stress's terms identified together
+// (on D the candidate with each part of the response apart, on S the gain per pascal), judged
+// and returned as reidentified_temperature does. A base identified under a moving load bends
+// its loop to the stress, so the correction rounds on it win back only part of the effect.
+// Field-drive models with one side per channel and a stress column.
+[[nodiscard]] std::optional<Reidentified> reidentified_stress_terms(
+    const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
+    const std::vector<double>& current, const Options& options);
+
 }  // namespace selfsense::diagnosis::detail
