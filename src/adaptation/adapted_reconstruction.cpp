@@ -55,6 +55,10 @@ DriftEstimatorConfig with_coefficients(DriftEstimatorConfig config,
   config.loop_per_k = t.sensor.loop.per_k;
   config.coupling_per_k = t.sensor.coupling.per_k;
   config.compliance_per_k = t.actuator.coupling.per_k;
+  if (t.increments.fitted()) {  // the estimator learns on increments: read it with theirs
+    config.permittivity_per_k = t.increments.linear_per_k;
+    config.loop_per_k = t.increments.loop_per_k;
+  }
   return config;
 }
 
@@ -195,6 +199,11 @@ void AdaptedReconstruction::set_temperature(double degc) noexcept {
     return;
   }
   const double dt = degc - coefficients_->reference_degc;  // the fitted sensor side's drift
+  if (coefficients_->increments.fitted()) {                // as the estimator reads it (increments)
+    estimator_.set_drift(coefficients_->increments.linear_per_k * dt,
+                         coefficients_->increments.loop_per_k * dt);
+    return;
+  }
   estimator_.set_drift(coefficients_->sensor.linear.scale(dt) - 1.0,
                        coefficients_->sensor.loop.scale(dt) - 1.0);
 }
@@ -202,6 +211,14 @@ void AdaptedReconstruction::set_temperature(double degc) noexcept {
 AdaptedReconstruction::Scales AdaptedReconstruction::scales(const Drift& dr) const noexcept {
   if (coefficients_ && measured_degc_ != kNoTemperature) {
     const double dt = measured_degc_ - coefficients_->reference_degc;
+    const models::SideTemperature& s = coefficients_->sensor;
+    const models::SideTemperature& a = coefficients_->actuator;
+    return {s.linear.scale(dt), s.loop.scale(dt), s.coupling.scale(dt),
+            a.linear.scale(dt), a.loop.scale(dt), a.coupling.scale(dt)};
+  }
+  if (coefficients_ && coefficients_->increments.fitted()) {
+    // Learned on increments, read as a temperature; every part at it from the level fit.
+    const double dt = dr.permittivity / coefficients_->increments.linear_per_k;
     const models::SideTemperature& s = coefficients_->sensor;
     const models::SideTemperature& a = coefficients_->actuator;
     return {s.linear.scale(dt), s.loop.scale(dt), s.coupling.scale(dt),
@@ -231,7 +248,7 @@ AdaptedReconstruction::FeedforwardScales AdaptedReconstruction::feedforward_scal
 
 Drift AdaptedReconstruction::drift() const noexcept {
   Drift dr = estimator_.drift();
-  if (coefficients_) {
+  if (coefficients_ && !coefficients_->increments.fitted()) {
     dr.temperature_degc =
         measured_degc_ != kNoTemperature
             ? measured_degc_

@@ -94,7 +94,8 @@ models::SideTemperature side_of(const std::array<double, kMax>& x, bool quadrati
 
 TemperatureFitResult fit_temperature(const models::TransducerModel& model,
                                      const TemperatureFitInput& in, double reference_degc,
-                                     bool quadratic, double min_span_k) {
+                                     bool quadratic, double min_span_k,
+                                     double min_field_step_v_per_m, double max_interval_s) {
   if (model.drive() != models::Drive::kField || model.vectorial || !model.sensor ||
       !model.actuator) {
     throw std::invalid_argument{
@@ -128,7 +129,15 @@ TemperatureFitResult fit_temperature(const models::TransducerModel& model,
   const std::size_t cols = quadratic ? 6 : 3;
   SideNormal sensor(cols);
   SideNormal actuator(cols);
+  SideNormal increments(4);
   TemperatureFitResult out;
+  // The estimator's gate (drift_estimator.hpp): the anchor's E, D, L_s, H_s, T and age.
+  struct Anchor {
+    double e, d, l, h, t, age;
+  };
+  Anchor anchor{};
+  bool anchored = false;
+  const double sample_time = model.sample_time;
   for (std::size_t k = 0; k < n; ++k) {
     const double e = in.field[k];
     const double fixed_s = s.offset() + s.quadratic() * e * e;
@@ -145,10 +154,28 @@ TemperatureFitResult fit_temperature(const models::TransducerModel& model,
         std::isfinite(ys) && std::isfinite(ya) &&
         std::all_of(xs.begin(), xs.end(), [](double v) { return std::isfinite(v); }) &&
         std::all_of(xa.begin(), xa.end(), [](double v) { return std::isfinite(v); });
-    if (!finite) continue;
+    if (!finite) {
+      anchored = false;
+      continue;
+    }
     sensor.add(xs, ys);
     actuator.add(xa, ya);
     ++out.samples;
+    const double d = in.sensed[k] - fixed_s;
+    if (!anchored || anchor.age > max_interval_s) {
+      anchored = true;
+      anchor = {e, d, ps.linear, ps.loop, t, 0.0};
+      continue;
+    }
+    anchor.age += sample_time;
+    if (!(std::abs(e - anchor.e) >= min_field_step_v_per_m)) continue;
+    const double dl = ps.linear - anchor.l;
+    const double dh = ps.loop - anchor.h;
+    const double dstress = s.coupling() * (t - anchor.t);
+    increments.add({dl * dt, dh * dt, dstress, dstress * dt, 0.0, 0.0},
+                   d - anchor.d - dl - dh - dstress);
+    anchor = {e, d, ps.linear, ps.loop, t, 0.0};
+    ++out.increments;
   }
   const std::array<double, kMax> ts = sensor.solve();
   const std::array<double, kMax> ta = actuator.solve();
@@ -159,6 +186,10 @@ TemperatureFitResult fit_temperature(const models::TransducerModel& model,
   out.sensor_rms_after = sensor.rms(ts);
   out.actuator_rms_before = actuator.rms({});
   out.actuator_rms_after = actuator.rms(ta);
+  if (out.increments >= 100) {
+    const std::array<double, kMax> ti = increments.solve();
+    out.coefficients.increments = {ti[0], ti[1]};
+  }
   return out;
 }
 

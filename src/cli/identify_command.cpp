@@ -153,18 +153,21 @@ nlohmann::json fit_temperature_coefficients(models::TransducerModel& model,
       "per K^2:\n"
       "  sensor   permittivity %+.3e %+.3e, loop %+.3e %+.3e, coupling   %+.3e %+.3e\n"
       "  actuator linear       %+.3e %+.3e, loop %+.3e %+.3e, compliance %+.3e %+.3e\n"
-      "  residual RMS: D %.3g -> %.3g C/m^2, S %.3g -> %.3g\n",
+      "  residual RMS: D %.3g -> %.3g C/m^2, S %.3g -> %.3g\n"
+      "  on the estimator's increments (%zu): permittivity %+.3e, loop %+.3e per K\n",
       name.c_str(), *lo, *hi, reference, se.linear.per_k, se.linear.per_k2, se.loop.per_k,
       se.loop.per_k2, se.coupling.per_k, se.coupling.per_k2, ac.linear.per_k, ac.linear.per_k2,
       ac.loop.per_k, ac.loop.per_k2, ac.coupling.per_k, ac.coupling.per_k2, fit.sensor_rms_before,
-      fit.sensor_rms_after, fit.actuator_rms_before, fit.actuator_rms_after);
+      fit.sensor_rms_after, fit.actuator_rms_before, fit.actuator_rms_after, fit.increments,
+      fit.coefficients.increments.linear_per_k, fit.coefficients.increments.loop_per_k);
   return {{"recording", name},
           {"reference_degc", reference},
           {"samples", fit.samples},
           {"sensed_rms_before", fit.sensor_rms_before},
           {"sensed_rms_after", fit.sensor_rms_after},
           {"strain_rms_before", fit.actuator_rms_before},
-          {"strain_rms_after", fit.actuator_rms_after}};
+          {"strain_rms_after", fit.actuator_rms_after},
+          {"increments", fit.increments}};
 }
 
 void run_identify(const IdentifyOptions& opt) {

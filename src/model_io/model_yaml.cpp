@@ -192,7 +192,7 @@ std::optional<ChannelCorrection> read_correction(YamlMap& corrections, std::stri
 }
 
 // temperature: {reference_degc, sensor: {linear: [per_k, per_k2], loop: [...], coupling: [...]},
-//               actuator: {...}}
+//               actuator: {...}, increments: [i_L, i_H] (optional)}
 TemperatureCoefficients read_temperature(YamlMap& m) {
   TemperatureCoefficients t;
   t.reference_degc = m.required<double>("reference_degc");
@@ -210,6 +210,12 @@ TemperatureCoefficients read_temperature(YamlMap& m) {
   };
   side("sensor", t.sensor);
   side("actuator", t.actuator);
+  if (m.has("increments")) {
+    std::vector<double> v;
+    m.read_sequence("increments", v);
+    if (v.size() != 2) m.fail("increments", "expected [linear_per_k, loop_per_k] (two numbers)");
+    t.increments = {v[0], v[1]};
+  }
   m.finish();
   return t;
 }
@@ -296,6 +302,9 @@ void emit_temperature(YAML::Emitter& out, const TemperatureCoefficients& t) {
     emit_sequence(out, "loop", {side->loop.per_k, side->loop.per_k2});
     emit_sequence(out, "coupling", {side->coupling.per_k, side->coupling.per_k2});
     out << YAML::EndMap;
+  }
+  if (t.increments.fitted()) {
+    emit_sequence(out, "increments", {t.increments.linear_per_k, t.increments.loop_per_k});
   }
   out << YAML::EndMap;
 }

@@ -26,6 +26,8 @@ bool TemperatureCoefficients::is_valid(const std::string& prefix, std::string* w
       if (!std::isfinite(p.poly->per_k2)) return bad(key + ".per_k2");
     }
   }
+  if (!std::isfinite(increments.linear_per_k)) return bad("increments.linear_per_k");
+  if (!std::isfinite(increments.loop_per_k)) return bad("increments.loop_per_k");
   return true;
 }
 

@@ -94,6 +94,12 @@ TEST(TemperatureFit, RecoversKnownCoefficients) {
   expect_polynomial(fit.coefficients.actuator.coupling, want.actuator.coupling);
   EXPECT_LT(fit.sensor_rms_after, 1e-6 * fit.sensor_rms_before);
   EXPECT_LT(fit.actuator_rms_after, 1e-6 * fit.actuator_rms_before);
+  // On the estimator's increments the synthetic sensor's drift is the levels' (its parts scale
+  // as a whole), to first order and as far as the increments tell L from H (measured 3.87e-3
+  // and -3.68e-3 per K): within 10 %.
+  EXPECT_GT(fit.increments, 1000U);
+  EXPECT_NEAR(fit.coefficients.increments.linear_per_k, want.sensor.linear.per_k, 4e-4);
+  EXPECT_NEAR(fit.coefficients.increments.loop_per_k, want.sensor.loop.per_k, 4e-4);
   // First order only: the quadratic terms are left out.
   const TemperatureFitResult linear =
       fit_temperature(r.model, {r.e, r.d, r.t, r.s, r.temp}, 25.0, false);
@@ -146,6 +152,35 @@ TEST(TemperatureFit, TheAdaptedReconstructionUsesThemWithAMeasuredTemperature) {
   // Cleared, the estimate (here frozen at the last measured temperature) serves again.
   with.clear_temperature();
   EXPECT_NEAR(with.drift().temperature_degc, r.temp.back(), 1e-6);
+}
+
+// With the increments' coefficients (models::IncrementTemperature) the estimator is read through
+// them: a measured temperature sets epsilon = i_L dtheta and lambda = i_H dtheta, the equivalent
+// temperature is epsilon / i_L, and learning from E and D alone (every scale a level polynomial
+// there) allocates nothing per sample and follows the synthetic ramp up.
+TEST(TemperatureFit, TheIncrementsCoefficientsReadTheEstimate) {
+  Ramp r = ramp(40000);
+  const TemperatureFitResult fit = fit_temperature(r.model, {r.e, r.d, r.t, r.s, r.temp}, 25.0);
+  ASSERT_TRUE(fit.coefficients.increments.fitted());
+  r.model.temperature = fit.coefficients;
+  AdaptedReconstruction measured(r.model, DriftEstimatorConfig{});
+  measured.set_temperature(40.0);
+  EXPECT_DOUBLE_EQ(measured.drift().permittivity, 15.0 * fit.coefficients.increments.linear_per_k);
+  EXPECT_DOUBLE_EQ(measured.drift().loop, 15.0 * fit.coefficients.increments.loop_per_k);
+  EXPECT_NEAR(measured.drift().temperature_degc, 40.0, 1e-9);
+  AdaptedReconstruction learned(r.model, DriftEstimatorConfig{});
+  test::AllocationCounter counter;
+  for (std::size_t k = 0; k < r.e.size(); ++k)
+    static_cast<void>(learned.step(r.e[k], r.d[k]));
+  EXPECT_EQ(counter.count(), 0U);
+  EXPECT_GT(learned.estimator().updates(), 1000U);
+  const Drift dr = learned.drift();
+  EXPECT_DOUBLE_EQ(dr.temperature_degc,
+                   25.0 + dr.permittivity / fit.coefficients.increments.linear_per_k);
+  // The synthetic ramp is fast (30 K in 4 s) and its stress moves a lot: the estimate follows
+  // it with a lag (measured 45.4 degC at the end of the ramp to 55 degC).
+  EXPECT_GT(dr.temperature_degc, 40.0);
+  EXPECT_LT(dr.temperature_degc, r.temp.back());
 }
 
 }  // namespace

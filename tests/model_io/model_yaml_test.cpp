@@ -111,7 +111,7 @@ TEST(ModelYaml, VectorialModelWithCreepRoundTrips) {
 
 // The temperature coefficients (models/temperature_coefficients.hpp) come back bit-identical
 // and do not change the parameter hash; a polynomial that is not two numbers, a missing side
-// and a model with one side are refused by key.
+// and a model with one side are refused by key; the increments' pair is optional.
 TEST(ModelYaml, TemperatureCoefficientsRoundTripAndAreCheckedByKey) {
   TransducerModel m = test::typical_transducer(1e-4);
   TemperatureCoefficients t;
@@ -132,6 +132,16 @@ TEST(ModelYaml, TemperatureCoefficientsRoundTripAndAreCheckedByKey) {
   side.replace(side.find("  actuator:\n    linear"), 11, "  actuatorx:");
   expect_error(side, "temperature");
   expect_error(kMinimal + "temperature:\n  reference_degc: 25\n", "temperature: needs a field");
+  // The increments' drift (optional): written when fitted, read back bit-identical.
+  t.increments = {3.8375e-3, -4.6e-3};
+  m.temperature = t;
+  const std::string with_increments = model_to_string(m);
+  const std::size_t at = with_increments.find("increments: [0.00383750");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_EQ(*model_from_string(with_increments).temperature, t);
+  std::string one = with_increments;
+  one.replace(at, one.find(',', at) + 2 - at, "increments: [");
+  expect_error(one, "temperature.increments: expected [linear_per_k, loop_per_k]");
 }
 
 TEST(ModelYaml, MinimalModelLoads) {

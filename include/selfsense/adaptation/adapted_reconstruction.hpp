@@ -41,6 +41,11 @@
 // sensor side keeps the learned (1 + epsilon) and (1 + lambda), and the coupling and the
 // actuator's three scales are the polynomials at the equivalent temperature dtheta_eq, the root
 // of g_L,s(dtheta) = 1 + epsilon nearest epsilon / per_k.
+// When the coefficients carry the estimator's increments (models::IncrementTemperature, fitted
+// on the estimator's own gated increments: the loop they see is not the levels'), the
+// estimator learns with their tie i_H / i_L, its epsilon means dtheta_eq = epsilon / i_L, and
+// all six scales, the sensor's too, are the level polynomials at dtheta_eq (docs/adaptation.md,
+// "Levels and increments"); a measured temperature sets epsilon = i_L dtheta.
 //
 // With the thermal model on (config.thermal.enabled, thermal_model.hpp), after each sample the
 // estimate is carried to the temperature the thermal law predicts for the next one, from the

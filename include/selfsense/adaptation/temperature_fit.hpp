@@ -15,6 +15,15 @@
 // that never moves). The result is the effective drift of the model's split, which is not
 // exactly the plant's permittivity and loop (docs/adaptation.md, "the split is the floor").
 //
+// The sensor side's drift as the online estimator sees it (models::IncrementTemperature): the
+// same model run, gated as the estimator gates (drift_estimator.hpp: an update where |delta E|
+// reaches min_field_step_v_per_m within max_interval_s of the anchor, at the model's sample
+// time), with delta x = x[k] - x[a] between anchor and update:
+//   delta D - delta L_s - delta H_s - d_s delta T
+//     = i_L dtheta delta L_s + i_H dtheta delta H_s + c0 d_s delta T + c1 dtheta d_s delta T
+// least squares in four coefficients, the same scaling and ridge; increments.linear_per_k and
+// loop_per_k are i_L and i_H (0, 0 with fewer than 100 updates).
+//
 // Offline: allocates, throws.
 #pragma once
 
@@ -40,7 +49,8 @@ struct TemperatureFitResult {
   double sensor_rms_after{0.0};     // with them
   double actuator_rms_before{0.0};  // the actuator side's [-]
   double actuator_rms_after{0.0};
-  std::size_t samples{0};  // finite samples used
+  std::size_t samples{0};     // finite samples used
+  std::size_t increments{0};  // gated increments in the increment fit
 };
 
 // Throws std::invalid_argument naming the reason: a model that is not field-driven with both
@@ -49,6 +59,8 @@ struct TemperatureFitResult {
 [[nodiscard]] TemperatureFitResult fit_temperature(const models::TransducerModel& model,
                                                    const TemperatureFitInput& in,
                                                    double reference_degc, bool quadratic = true,
-                                                   double min_span_k = 2.0);
+                                                   double min_span_k = 2.0,
+                                                   double min_field_step_v_per_m = 20.0e3,
+                                                   double max_interval_s = 0.05);
 
 }  // namespace selfsense::adaptation

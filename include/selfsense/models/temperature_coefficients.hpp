@@ -13,6 +13,14 @@
 // Sensor side: g_L the permittivity, g_H the loop, g_c the coupling d. Actuator side: g_L the
 // linear part d E, g_H the loop, g_c the compliance s^E. The offsets and quadratic terms do not
 // change.
+//
+// The sensor side's drift as the online estimator sees it (increments, first order; optional,
+// 0: none): the same fit on the field increments the estimator learns from
+// (adaptation/drift_estimator.hpp), between gated samples a and k:
+//   delta D - delta L - delta H - d delta T = (i_L delta L + i_H delta H) dtheta + ...
+// On the main job's ramp it is not the levels' (loop -4.6e-3 against -3.1e-3 per K): the
+// estimator reads its learned drift with these and the reconstruction takes the level
+// polynomials at the temperature they give (docs/adaptation.md, "Levels and increments").
 #pragma once
 
 #include <string>
@@ -35,10 +43,19 @@ struct SideTemperature {
   friend bool operator==(const SideTemperature&, const SideTemperature&) = default;
 };
 
+// The sensor side's first-order drift on the estimator's increments (header comment).
+struct IncrementTemperature {
+  double linear_per_k{0.0};  // i_L: the permittivity [1/K]; 0: not fitted
+  double loop_per_k{0.0};    // i_H: the loop [1/K]
+  [[nodiscard]] bool fitted() const noexcept { return linear_per_k != 0.0; }
+  friend bool operator==(const IncrementTemperature&, const IncrementTemperature&) = default;
+};
+
 struct TemperatureCoefficients {
   double reference_degc{25.0};  // the identification temperature [degC]
   SideTemperature sensor{};
   SideTemperature actuator{};
+  IncrementTemperature increments{};  // model file: `increments: [i_L, i_H]`, optional
 
   // Every value finite; *why names the key under `prefix` ("temperature.sensor.loop.per_k:
   // must be finite").
