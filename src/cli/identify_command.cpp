@@ -235,11 +235,15 @@ void run_identify(const IdentifyOptions& opt) {
       "%.2f s\n",
       opt.structure.c_str(), signals.source.c_str(), n, signals.sample_time, split, seconds);
   if (*structure == models::Structure::kPreisachCreep) {
-    const bool chosen = sizes.choose_dead_zones || sizes.choose_bias_levels;
-    print_chosen_sizes(model, !chosen ? "given (--dead-zones, --bias-levels)"
-                              : sizes.choose_dead_zones && sizes.choose_bias_levels
-                                  ? "chosen on the fitting data"
-                                  : "chosen on the fitting data, partly given");
+    const char* how = "given (--dead-zones, --bias-levels)";
+    if (sizes.choose_dead_zones && sizes.choose_bias_levels) {
+      how = "chosen on the fitting data";
+    } else if (sizes.choose_bias_levels) {
+      how = "chosen on the fitting data (dead zones given)";
+    } else if (sizes.choose_dead_zones) {
+      how = "chosen on the fitting data (hinges given)";
+    }
+    print_chosen_sizes(model, how);
   }
   if (*structure == models::Structure::kStressHysteresis && sizes.choose_plays) {
     std::printf("sizes chosen on the fitting data: %zu plays\n",
