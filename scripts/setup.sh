@@ -27,9 +27,15 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 jobs=$(nproc)
 cd "$root"
 
-say() { printf '\n== %s\n' "$*"; }
+# Each step's heading with the seconds since the start, so that a run's log times its steps.
 setup_begin=$SECONDS
+say() { printf '\n== [%d s] %s\n' $((SECONDS - setup_begin)) "$*"; }
 demo_build=${SELFSENSE_DEMO_BUILD:-build}
+
+# Release's flags as CMake sets them for GCC (the checks and the packages), and the demo's
+# lighter ones (below, `demo`): one build directory may serve both, so each sets its own.
+release_flags='-O3 -DNDEBUG'
+demo_release_flags='-O1 -DNDEBUG'
 
 # What the programs need to build (the demo's whole list): compiler, CMake, the libraries.
 packages=(
@@ -210,8 +216,14 @@ run_self_sensing() {
   "$cli" plant --config "$cfg" --excitation identification --seed 1 --out "$out/identification.csv"
   "$cli" plant --config config/plant/reconstruction-validation.yaml --excitation mix --seed 2 \
     --out "$out/validation.csv"
-  say "main job: identify the preisach-creep model, validate on new excitation"
+  # The sizes given are those identify chooses on this recording (8 dead zones per side, 7
+  # hinges per play, both sides; asserted by PlantAccuracy.PreisachClassImprovesSelfSensing-
+  # OnNewExcitation): the same model byte for byte, fitted once per side instead of once per
+  # candidate as well (28 s of CPU instead of 67 s, 2026-11-28). `selfsense identify` without
+  # them chooses (docs/results.md).
+  say "main job: identify the preisach-creep model (8 dead zones, 7 hinges per play), validate on new excitation"
   "$cli" identify --recording "$out/identification.csv" --structure preisach-creep \
+    --dead-zones 8 --bias-levels 7 \
     --holdout 0 --validate "$out/validation.csv" --out "$out/model.yaml" --json "$out/fit.json"
   say "main job: self-sensing reconstruction of T and S from E and D"
   "$cli" reconstruct --model "$out/model.yaml" --recording "$out/validation.csv" \
@@ -361,14 +373,20 @@ case "$mode" in
     # another build directory, e.g. to time a fresh build beside build/). A unity build (CMake
     # compiles each target's sources in batches of 16): the headers every file parses (CLI11,
     # which compiles its whole parser in every file that uses it, nlohmann/json, yaml-cpp, Eigen)
-    # are compiled once a batch instead of once a file; the same code at the same -O3, in less
-    # than half the compiler's time (README). Batches of 16 rather than CMake's 8: 26 compiles
-    # instead of 33 and 19 % less compiler CPU (237 s against 291 s), while the longest batch
-    # (98 s at load average 5.5) stays well under half the whole, so two cores stay busy.
-    # Only here: the checks (`test`) build file by file, as clang-tidy reads them.
-    say "build: $demo_build (Release, unity): selfsense and selfsensed"
+    # are compiled once a batch instead of once a file, in less than half the compiler's time
+    # (README). Batches of 16 rather than CMake's 8: 26 compiles instead of 33 and 19 % less
+    # compiler CPU (237 s against 291 s), while the longest batch stays well under half the
+    # whole, so two cores stay busy.
+    # At -O1, not Release's -O3: the build's steps sum to 540 s instead of 870 s (-O2: 690 s),
+    # the identification writes the same model byte for byte in the same time (Eigen's kernels
+    # carry it), and the daemon's cycle stays at 2 us median, 4 us p99 of its 100 us period,
+    # the main job's figures within run-to-run scatter of -O3's (README, 2026-11-28).
+    # Only here: the checks (`test`) and the packages build file by file at -O3 (set again
+    # there, since they may share this build directory).
+    say "build: $demo_build (unity, -O1): selfsense and selfsensed"
     cmake -S . -B "$demo_build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSELFSENSE_BUILD_TESTS=OFF \
-      -DSELFSENSE_BUILD_BENCHMARKS=OFF -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=16
+      -DSELFSENSE_BUILD_BENCHMARKS=OFF -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=16 \
+      "-DCMAKE_CXX_FLAGS_RELEASE=$demo_release_flags"
     cmake --build "$demo_build" -j "$jobs" --target selfsense selfsensed
     say "main job: selfsense demo"
     "$demo_build/src/cli/selfsense" demo
@@ -385,7 +403,8 @@ case "$mode" in
     # and builds in batches (clang-tidy reads compile_commands.json, which then names the
     # batches, not the files).
     configure_and_build build -DCMAKE_BUILD_TYPE=Release -DSELFSENSE_WERROR=ON \
-      -DSELFSENSE_BUILD_TESTS=ON -DSELFSENSE_BUILD_BENCHMARKS=ON -DCMAKE_UNITY_BUILD=OFF
+      -DSELFSENSE_BUILD_TESTS=ON -DSELFSENSE_BUILD_BENCHMARKS=ON -DCMAKE_UNITY_BUILD=OFF \
+      "-DCMAKE_CXX_FLAGS_RELEASE=$release_flags"
     run_tests build -LE vm
     run_vm_tests build
     check_tidy
@@ -423,7 +442,8 @@ case "$mode" in
     # directory as demo and test: no test is built for it, and what they built is reused.
     say "build: build (Release): the packaged programs and libraries"
     launcher=$(compiler_launcher)
-    cmake -S . -B build -G Ninja ${launcher:+"$launcher"} -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=OFF
+    cmake -S . -B build -G Ninja ${launcher:+"$launcher"} -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=OFF \
+      "-DCMAKE_CXX_FLAGS_RELEASE=$release_flags"
     cmake --build build -j "$jobs" --target selfsense_packaged
     say "package: cpack (DEB) into build/packages/"
     rm -f build/packages/*.deb

@@ -74,8 +74,9 @@ void print_table(const std::vector<ChannelFigures>& fit, const std::vector<Chann
   }
 }
 
-// What preisach-creep chose on the fitting data (transducer_fit.hpp), read off the model.
-void print_chosen_sizes(const models::TransducerModel& model) {
+// What preisach-creep chose on the fitting data (transducer_fit.hpp), read off the model; `how`
+// says whether they were chosen or given (--dead-zones, --bias-levels).
+void print_chosen_sizes(const models::TransducerModel& model, const char* how) {
   const auto describe = [](const char* name, const std::optional<models::SideModel>& side) {
     if (!side) return;
     const auto& s = side->op.superposition;
@@ -87,7 +88,7 @@ void print_chosen_sizes(const models::TransducerModel& model) {
     std::printf("  %s: %zu dead zones per side, %zu hinges per play (%zu hinges)\n", name,
                 dead_zones, plays == 0 ? 0 : hinges / plays, hinges);
   };
-  std::printf("sizes chosen on the fitting data:\n");
+  std::printf("sizes %s:\n", how);
   describe("sensor", model.sensor);
   describe("actuator", model.actuator);
 }
@@ -236,7 +237,17 @@ void run_identify(const IdentifyOptions& opt) {
       "selfsense identify: %s from %s (%zu samples, Ts %g s); fitted on the first %zu in "
       "%.2f s\n",
       opt.structure.c_str(), signals.source.c_str(), n, signals.sample_time, split, seconds);
-  if (*structure == models::Structure::kPreisachCreep) print_chosen_sizes(model);
+  if (*structure == models::Structure::kPreisachCreep) {
+    const char* how = "given (--dead-zones, --bias-levels)";
+    if (sizes.choose_dead_zones && sizes.choose_bias_levels) {
+      how = "chosen on the fitting data";
+    } else if (sizes.choose_bias_levels) {
+      how = "chosen on the fitting data (dead zones given)";
+    } else if (sizes.choose_dead_zones) {
+      how = "chosen on the fitting data (hinges given)";
+    }
+    print_chosen_sizes(model, how);
+  }
   if (*structure == models::Structure::kStressHysteresis && sizes.choose_plays) {
     std::printf("sizes chosen on the fitting data: %zu plays\n",
                 model.vectorial->basis.thresholds.size() - 1);

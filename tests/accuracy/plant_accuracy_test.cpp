@@ -2,6 +2,7 @@
 // (hysteresis and creep on D and S, a varying load, sensor noise of about 1e-4 of range).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -187,6 +188,21 @@ TEST(PlantAccuracy, PreisachClassImprovesSelfSensingOnNewExcitation) {
         100 * pc.stress.nrmse, 100 * hc.strain.nrmse, 100 * hc.strain.max, 100 * hc.stress.nrmse);
     worst(worst_pc, pc);
     worst(worst_hc, hc);
+  }
+  // The sizes chosen on this recording: 8 dead zones per side and 7 hinges per play on both
+  // sides. scripts/setup.sh demo gives them (--dead-zones 8 --bias-levels 7) to fit once per side
+  // instead of judging every candidate; the same model, checked here so that it stays so.
+  for (const auto* side : {&m.preisach_creep.sensor, &m.preisach_creep.actuator}) {
+    ASSERT_TRUE(side->has_value());
+    const auto& op = (*side)->op;
+    EXPECT_EQ(std::max(op.superposition.upper_thresholds.size(),
+                       op.superposition.lower_thresholds.size()),
+              8U);
+    std::vector<double> plays = op.hinges.thresholds;
+    std::sort(plays.begin(), plays.end());
+    plays.erase(std::unique(plays.begin(), plays.end()), plays.end());
+    ASSERT_FALSE(plays.empty());
+    EXPECT_EQ(op.hinges.thresholds.size(), 7 * plays.size());
   }
   // The main job's validation (scripts/setup.sh demo): config/plant/reconstruction-validation.yaml,
   // mix seed 2. Measured 0.103 %, 0.284 %, 0.398 %.

@@ -77,7 +77,8 @@ printf 'plant:\n  sample_rate_hz: 500\n  hysteresis: {enabled: true}\nexcitation
 "$bin" plant --config "$work/loops.yaml" --excitation loops --out "$work/loops.csv" >/dev/null
 "$bin" identify --recording "$work/loops.csv" --structure preisach-creep --out "$work/p.yaml" \
   --plays 8 --eigenvalues 2 --dead-zones 2 >"$work/p.txt"
-grep -q '^sizes chosen on the fitting data:' "$work/p.txt" || fail "preisach-creep did not say its sizes"
+grep -q '^sizes chosen on the fitting data (dead zones given):' "$work/p.txt" ||
+  fail "preisach-creep did not say its sizes: $(cat "$work/p.txt")"
 grep -q '^structure: preisach-creep' "$work/p.yaml" || fail "model is not preisach-creep"
 "$bin" identify --recording "$work/loops.csv" --structure preisach-creep --out "$work/p3.yaml" \
   --plays 8 --eigenvalues 2 --bias-levels 3 >/dev/null

@@ -5,7 +5,8 @@
 # others. The PROGRAMs (host-built, e.g. the selfsense tool) go in with their libraries;
 # --packages BUILD_DIR: the build's selfsense package (tests/package/packages_dir.sh) as
 # /payload/files/packages/, and the same as a lower version in /payload/files/packages/previous/
-# (the upgrade's starting point), unless --no-previous. --only NAME (repeated): only those
+# (the upgrade's starting point), unless --no-previous; with it payload/lib/ as
+# /payload/files/lib/ (the tests' code to install it). --only NAME (repeated): only those
 # tests/vm/payload/NAME.sh. SELFSENSE_VM_ARCH (amd64 or arm64) chooses the VM (scripts/vm/).
 #   tests/vm/boot.sh OUT_DIR [PROGRAM... | --file PATH... | --packages BUILD_DIR | --no-previous | --only NAME...]
 set -euo pipefail
@@ -66,7 +67,8 @@ if [ -n "$packages" ]; then
     mkdir -p "$out-vm/packages"
     cp "$built"/selfsense_*_"$vm_arch".deb "$out-vm/packages/" || { echo "FAIL: no $vm_arch package"; exit 1; }
   fi
-  args+=(--file "$out-vm/packages")
+  # With the code the tests that install it share (payload/lib/package.sh).
+  args+=(--file "$out-vm/packages" --file "$vm_repo/tests/vm/payload/lib")
 fi
 [ ${#tests[@]} -gt 0 ] || tests=("$vm_repo"/tests/vm/payload/*.sh)
 status=0

@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # Host side of payload/can_loop.sh: selfsensed with its SocketCAN driver against
-# `selfsense sim-device --can` on vcan in the VM (position loop, injected frames counted,
-# timeouts and safe output when the node dies, CAN FD).
+# `selfsense sim-device --can` on vcan in the VM, both from this build's package installed with
+# apt (position loop, injected frames counted, timeouts and safe output when the node dies, CAN FD).
 #   tests/vm/can_loop.sh OUT_DIR   (after tests/vm/boot.sh OUT_DIR ...)
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=lib.sh
 source "$(dirname "${BASH_SOURCE[0]}")/lib.sh"
 
 vm_check_test "${1:?usage: tests/vm/can_loop.sh OUT_DIR}" can_loop \
+  'installed=[^ ]+ install ok installed' \
+  'selfsensed=/usr/bin/selfsensed' \
   'check_config=ok' \
   'state_armed="armed"' \
   'position_reached=yes' \

@@ -1,13 +1,17 @@
 #!/usr/bin/env bash
 # Inside the VM, with the kernel's SocketCAN stack: the daemon selfsensed with its CAN driver
-# (config/can-sim.yaml) against `selfsense sim-device --can` (the simulated transducer as a CAN
-# node) on a vcan interface. Checks that the loop, armed in position mode through
+# against `selfsense sim-device --can` (the simulated transducer as a CAN node) on a vcan
+# interface, both as this build's selfsense package installs them with apt (lib/package.sh;
+# /usr/bin, Debian's libraries), on its example /etc/selfsense/examples/can-sim.yaml and the
+# plant under /usr/share/selfsense, run as plain processes beside can-utils. Checks that the loop, armed in position mode through
 # `selfsense ctl`, brings S_hat to the setpoint; that candump sees the input and command frames;
 # that a short input frame and an error frame injected with cansend are counted (and do not
 # stop the loop); that killing the node gives timeout faults and the safe output (E = 0 on the
 # bus); then the same over CAN FD (MTU 72). Prints "name=value" lines that
 # tests/vm/can_loop.sh checks; the figures (latency, loop rate) are printed, not asserted.
 set -euo pipefail
+# shellcheck source-path=SCRIPTDIR source=lib/package.sh
+source /payload/files/lib/package.sh
 
 work=/run/can_loop
 fail() {
@@ -24,9 +28,14 @@ cleanup() {
 trap cleanup EXIT
 
 modprobe -a can can_raw vcan || fail "modprobe can can_raw vcan"
-mkdir -p "$work"
-cp -r /payload/files/config "$work/"
+vm_install_package
+echo "installed=$(dpkg-query -W -f='${Version} ${Status}' selfsense)"
+echo "selfsensed=$(command -v selfsensed)"
+mkdir -p "$work/config/plant"
 cfg=$work/config/can-sim.yaml
+# The packaged example with this test's paths: socket, recordings and telemetry under $work/can-sim.
+sed -e "s|/run/selfsensed/|$work/can-sim/|" -e "s|/var/lib/selfsensed/|$work/can-sim/|" \
+  /etc/selfsense/examples/can-sim.yaml >"$cfg"
 # Software emulation on shared cores is far from real time: a 500 Hz loop and node, a generous
 # receive timeout, and a plant sampled at 2 kHz without its 2 kHz mount resonance (a tenth of
 # the 20 kHz plant's work per second).
@@ -35,7 +44,7 @@ sed -i -e 's/interface: vcan0 /interface: vcanl0 /' -e 's/rx_timeout_ms: 50 /rx_
 rate=500
 plant=$work/config/plant/can-vm.yaml
 sed -e 's/sample_rate_hz: 20000/sample_rate_hz: 2000/' -e '/^  mechanics:/,/^  [a-z]/s/enabled: true/enabled: false/' \
-  "$work/config/plant/daemon.yaml" >"$plant"
+  /usr/share/selfsense/plant/daemon.yaml >"$plant"
 ip link add dev vcanl0 type vcan
 ip link set up vcanl0
 ip link add dev vcanl1 type vcan
@@ -44,7 +53,7 @@ ip link set up vcanl1
 selfsense check-config "$cfg" >/dev/null || fail "check-config rejected $cfg"
 echo "check_config=ok"
 
-sock=$work/build/can-sim/control.sock
+sock=$work/can-sim/control.sock
 ctl() { selfsense ctl --socket "$sock" "$@"; }
 field() { sed -n "s/.*\"$1\":\([^,}]*\).*/\1/p" <<<"$2" | head -1; }
 wait_socket() {
@@ -155,7 +164,8 @@ selfsense sim-device --can vcanl0 --config "$cfg" --plant "$plant" --rate "$rate
 sim=$!
 pids+=("$sim")
 sleep 0.5
-rt=$(can_driver_realtime vcanl0 "$cfg" 2>&1) || true
+# A test program, not in the package: copied in with its libraries (tests/vm/boot.sh).
+rt=$(LD_LIBRARY_PATH=/payload/lib /payload/bin/can_driver_realtime vcanl0 "$cfg" 2>&1) || true
 echo "$rt"
 kill -TERM "$sim" 2>/dev/null || true
 wait "$sim" || true
@@ -164,7 +174,7 @@ wait "$sim" || true
 fd_cfg=$work/config/can-fd.yaml
 sed -e 's/interface: vcanl0 /interface: vcanl1 /' -e 's/^  fd: false /  fd: true /' \
   -e 's|can-sim/|can-fd/|' "$cfg" >"$fd_cfg"
-sock=$work/build/can-fd/control.sock
+sock=$work/can-fd/control.sock
 candump -L vcanl1 >"$work/candump-fd.log" &
 dump=$!
 pids+=("$dump")
@@ -204,7 +214,7 @@ sed -n 's/^can: vcanl1: /fd_driver: /p' "$work/daemon-fd.log"
 for r in 1000 2000; do
   sweep_cfg=$work/config/can-sweep-$r.yaml
   sed -e "s/rate_hz: 500 /rate_hz: $r /" -e "s|can-sim/|can-sweep-$r/|" "$cfg" >"$sweep_cfg"
-  sock=$work/build/can-sweep-$r/control.sock
+  sock=$work/can-sweep-$r/control.sock
   selfsense sim-device --can vcanl0 --config "$sweep_cfg" --plant "$plant" --rate "$r" \
     --duration 5 >"$work/sim-sweep.log" 2>&1 &
   sim=$!

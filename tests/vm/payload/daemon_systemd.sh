@@ -1,11 +1,9 @@
 #!/usr/bin/env bash
-# Inside the VM, under systemd as PID 1: the selfsense Debian package installed with apt from
-# /payload/files/packages (offline: the image holds its Depends), run as it ships: the unit
-# from /lib/systemd/system (ExecStart /usr/bin/selfsensed), the user from sysusers.d, the
-# packaged /etc/selfsense/selfsensed.yaml on the simulated transducer with the emulation's
-# tolerances put in (the administrator's change). The package is this build's as the previous
-# version (packages/previous/, VERSION~prev: the same files) when the boot brought one, so that
-# package_systemd upgrades from this install instead of installing again; else this build's.
+# Inside the VM, under systemd as PID 1: the selfsense Debian package installed with apt
+# (lib/package.sh: this build's, as the previous version when the boot brought one, which
+# package_systemd upgrades), run as it ships: the unit from /lib/systemd/system (ExecStart
+# /usr/bin/selfsensed), the user from sysusers.d, the packaged /etc/selfsense/selfsensed.yaml on
+# the simulated transducer with the emulation's tolerances put in (the administrator's change).
 # Checks that `systemd-analyze verify` accepts the unit, that the service is active once it
 # sent READY=1, that it keeps itself alive through the watchdog, that a frozen daemon gets
 # restarted by the watchdog, that a kill -9 of an armed daemon restarts it faulted, and that
@@ -13,9 +11,8 @@
 # Prints "name=value" lines that tests/vm/daemon_systemd.sh checks.
 set -euo pipefail
 
-# The installed programs with Debian's libraries, not the payload's.
-unset LD_LIBRARY_PATH
-export PATH=/usr/sbin:/usr/bin:/sbin:/bin DEBIAN_FRONTEND=noninteractive
+# shellcheck source-path=SCRIPTDIR source=lib/package.sh
+source /payload/files/lib/package.sh
 unit=selfsensed.service
 fail() {
   echo "FAILED: $*"
@@ -25,16 +22,12 @@ fail() {
 }
 prop() { systemctl show -p "$1" --value "$unit"; }
 
-arch=$(dpkg --print-architecture)
-deb=$(ls /payload/files/packages/previous/selfsense_*_"$arch".deb /payload/files/packages/selfsense_*_"$arch".deb \
-  2>/dev/null | head -1 || true)
-[ -n "$deb" ] || fail "no selfsense package in /payload/files/packages (tests/vm/boot.sh --packages)"
-apt-get -q -y -o Dpkg::Use-Pty=0 install "$deb" >/tmp/apt-install-daemon.log 2>&1 ||
-  { tail -20 /tmp/apt-install-daemon.log; fail "apt-get install $deb"; }
+vm_install_package
 echo "installed=$(dpkg-query -W -f='${Version} ${Status}' selfsense)"
 echo "unit_path=$(prop FragmentPath)"
 echo "exec_start=$(prop ExecStart | sed -n 's/.*path=\([^ ;]*\).*/\1/p')"
-# A first install starts nothing (postinst only restarts a running service on an upgrade).
+# An install starts nothing (postinst only restarts a running service on an upgrade), nor does
+# can_loop, which may have installed it first.
 echo "is-active_after_install=$(systemctl is-active "$unit" || true)"
 
 # Software emulation is far from real time: a 1 kHz loop, degraded timing allowed, overruns
