@@ -41,9 +41,11 @@ ControlClient::ControlClient(std::filesystem::path path, std::chrono::millisecon
   if (!fd.valid()) throw ControlClientError(where + ": " + detail::errno_text(errno));
   // A blocking connect waits while the server's backlog is full; the send timeout bounds it.
   const auto whole = std::chrono::duration_cast<std::chrono::seconds>(timeout);
+  // timeval's fields are 32 bits on armhf: a timeout in seconds and its microseconds fit.
   const timeval limit{
-      whole.count(),
-      std::chrono::duration_cast<std::chrono::microseconds>(timeout - whole).count()};
+      static_cast<decltype(timeval::tv_sec)>(whole.count()),
+      static_cast<decltype(timeval::tv_usec)>(
+          std::chrono::duration_cast<std::chrono::microseconds>(timeout - whole).count())};
   static_cast<void>(::setsockopt(fd.get(), SOL_SOCKET, SO_SNDTIMEO, &limit, sizeof limit));
   // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): the sockets API takes sockaddr*.
   if (::connect(fd.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <system_error>
 #include <utility>
@@ -91,6 +92,16 @@ void from_yaml(const YAML::Node& node, const std::string& where, std::uint64_t& 
     type_error(node, where, "a non-negative integer");
   }
   convert(node, where, "a non-negative integer", out);
+}
+void from_yaml(const YAML::Node& node, const std::string& where, unsigned int& out) {
+  std::uint64_t wide = 0;
+  from_yaml(node, where, wide);
+  if (wide > std::numeric_limits<unsigned int>::max()) {
+    type_error(
+        node, where,
+        "a non-negative integer up to " + std::to_string(std::numeric_limits<unsigned int>::max()));
+  }
+  out = static_cast<unsigned int>(wide);
 }
 void from_yaml(const YAML::Node& node, const std::string& where, bool& out) {
   convert(node, where, "true or false", out);

@@ -4,7 +4,7 @@
 // (docs/benchmarks.md, "The loop's timing").
 //
 //   build/tests/bench/loop_timing_bench [SECONDS] [PRIORITY] [CPU] [--check] [--self]
-//                                       [--regress-ns N]                 (10 s, 80, -1)
+//                                       [--regress-ns N] [--adapt]       (10 s, 80, -1)
 //
 // PRIORITY 1..98: SCHED_FIFO for both (needs CAP_SYS_NICE; cyclictest -p); 0 runs both under
 // the normal scheduler. CPU >= 0 pins both to that CPU (cyclictest -a); -1 leaves them free.
@@ -21,6 +21,8 @@
 // --self: the same rounds with cyclictest in place of the loop (the statistic's spread when
 // nothing differs). --regress-ns N: a deliberate regression of the loop's wake-up path, a spin
 // of N ns after each sleep returns and before the clock is read (the check must fail on it).
+// --adapt: the loop runs the adapted reconstruction (config/sim.yaml's `adaptation:` section
+// with `enabled: true`, as the daemon builds it): the drift estimator's cost in the cycle.
 //
 // What runs. The loop is the daemon's (config/sim.yaml read by the daemon's loader, the
 // simulated transducer built by the driver registry, the shipped model, position control with
@@ -52,6 +54,7 @@
 #include <thread>
 #include <vector>
 
+#include "selfsense/adaptation/adapted_reconstruction.hpp"
 #include "selfsense/control/wave_generator.hpp"
 #include "selfsense/daemon/config.hpp"
 #include "selfsense/drivers/registry/registry.hpp"
@@ -233,7 +236,7 @@ struct LoopFigures {
 };
 
 LoopFigures run_loop(const std::string& source, double rate_hz, double seconds, int priority,
-                     int cpu, std::int64_t regress_ns) {
+                     int cpu, std::int64_t regress_ns, bool adapt) {
   drivers::Registry registry;
   daemon::ConfigResult loaded = daemon::load_config(source + "/config/sim.yaml", &registry);
   if (!loaded.ok()) throw std::runtime_error(loaded.problems.front());
@@ -252,9 +255,15 @@ LoopFigures run_loop(const std::string& source, double rate_hz, double seconds, 
   }
   const models::TransducerModel model = models::load_model(config.model);
   DrainedSink sink;
-  runtime::Loop loop(config.loop_config(), driver,
-                     std::make_unique<models::Reconstruction>(model, models::RuntimeOptions{ts}),
-                     runtime::Controller(config.control, model.actuator, ts), &sink);
+  const runtime::Controller controller(config.control, model.actuator, ts);
+  runtime::Loop loop = adapt ? runtime::Loop(config.loop_config(), driver,
+                                             std::make_unique<adaptation::AdaptedReconstruction>(
+                                                 model, config.adaptation.estimator, ts),
+                                             controller, &sink)
+                             : runtime::Loop(config.loop_config(), driver,
+                                             std::make_unique<models::Reconstruction>(
+                                                 model, models::RuntimeOptions{ts}),
+                                             controller, &sink);
   TimingClock clock(n, driver, regress_ns);
   runtime::LoopRunner runner(loop, clock, std::llround(ts * 1e9), runtime::RtOptions{priority, cpu},
                              nullptr);
@@ -361,10 +370,13 @@ void print_row(const char* who, const Percentiles& p) {
 
 // One rate: cyclictest, then the loop; the table printed. Returns the loop / cyclictest ratio
 // of the wake-up latency's p99, 0 when cyclictest did not run.
-double run_rate(double rate, double seconds, int priority, int cpu, std::int64_t regress_ns) {
+double run_rate(double rate, double seconds, int priority, int cpu, std::int64_t regress_ns,
+                bool adapt) {
   const Percentiles cyclictest = run_cyclictest(rate, seconds, priority, cpu);
-  const LoopFigures loop = run_loop(SELFSENSE_SOURCE_DIR, rate, seconds, priority, cpu, regress_ns);
-  std::printf("\n%.0f kHz (period %.0f us), loop %s\n", rate * 1e-3, 1e6 / rate, loop.rt.c_str());
+  const LoopFigures loop =
+      run_loop(SELFSENSE_SOURCE_DIR, rate, seconds, priority, cpu, regress_ns, adapt);
+  std::printf("\n%.0f kHz (period %.0f us), loop %s%s\n", rate * 1e-3, 1e6 / rate, loop.rt.c_str(),
+              adapt ? ", adapted reconstruction" : "");
   std::printf("  %-28s %9s  %8s  %8s  %8s  %9s\n", "wake-up latency [us]", "samples", "p50", "p99",
               "p99.9", "max");
   double ratio = 0.0;
@@ -397,7 +409,7 @@ double run_rate(double rate, double seconds, int priority, int cpu, std::int64_t
 // both with --self), SECONDS each, the order alternating. Prints each round and returns the
 // median of the rounds' p99 ratios, 0 when cyclictest did not run.
 double check_rate(double rate, double seconds, int priority, int cpu, bool self,
-                  std::int64_t regress_ns) {
+                  std::int64_t regress_ns, bool adapt) {
   std::printf("\n%.0f kHz: %d rounds, %.0f s per block, %s / cyclictest p99 [us]\n", rate * 1e-3,
               kRounds, seconds, self ? "cyclictest" : "loop");
   std::vector<double> ratios;
@@ -406,7 +418,8 @@ double check_rate(double rate, double seconds, int priority, int cpu, bool self,
       if (self) return run_cyclictest(rate, seconds, priority, cpu).p99_us;
       // Cut to whole microseconds, as cyclictest's histogram cuts its latencies.
       return std::floor(
-          run_loop(SELFSENSE_SOURCE_DIR, rate, seconds, priority, cpu, regress_ns).wake.p99_us);
+          run_loop(SELFSENSE_SOURCE_DIR, rate, seconds, priority, cpu, regress_ns, adapt)
+              .wake.p99_us);
     };
     double reference = 0.0;
     double measured = 0.0;
@@ -443,6 +456,7 @@ int main(int argc, char** argv) {
   };
   const bool check = take_flag("--check");
   const bool self = take_flag("--self");
+  const bool adapt = take_flag("--adapt");
   std::int64_t regress_ns = 0;
   if (const auto it = std::find(args.begin(), args.end(), "--regress-ns");
       it != args.end() && it + 1 != args.end()) {
@@ -458,7 +472,7 @@ int main(int argc, char** argv) {
     static_cast<void>(
         std::fprintf(stderr,
                      "usage: loop_timing_bench [SECONDS >= 1] [PRIORITY 0..98] [CPU] [--check "
-                     "[--self]] [--regress-ns N]\n"));
+                     "[--self]] [--regress-ns N] [--adapt]\n"));
     return 2;
   }
   std::printf("loop_timing_bench: %.0f s per run, priority %d, cpu %d, load average now: ", seconds,
@@ -473,10 +487,10 @@ int main(int argc, char** argv) {
   for (const double rate : {10000.0, 20000.0}) {
     try {
       if (!check) {
-        if (run_rate(rate, seconds, priority, cpu, regress_ns) == 0.0) status = 1;
+        if (run_rate(rate, seconds, priority, cpu, regress_ns, adapt) == 0.0) status = 1;
         continue;
       }
-      double median = check_rate(rate, seconds, priority, cpu, self, regress_ns);
+      double median = check_rate(rate, seconds, priority, cpu, self, regress_ns, adapt);
       if (median == 0.0) {
         std::printf("--check: skipped, cyclictest did not run\n");
         return kSkipped;
@@ -486,7 +500,7 @@ int main(int argc, char** argv) {
         // the rate measured once more, failed only if it is over again (the rule of the
         // daemon's real-time tests).
         std::printf("--check: median %.2f over %.1f, measured again\n", median, kCheckedRatio);
-        median = check_rate(rate, seconds, priority, cpu, self, regress_ns);
+        median = check_rate(rate, seconds, priority, cpu, self, regress_ns, adapt);
       }
       if (median == 0.0 || median > kCheckedRatio) {
         std::printf("--check: FAILED at %.0f kHz (median %.2f over %.1f)\n", rate * 1e-3, median,

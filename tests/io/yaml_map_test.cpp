@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstddef>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -66,6 +67,21 @@ TEST(YamlMap, WrongTypesNameTheKey) {
             "C.yaml:4: u: expected a non-negative integer, got '-3'");
   EXPECT_EQ(error_of([&] { static_cast<void>(root.required<double>("m")); }),
             "C.yaml:5: m: expected a number, got a mapping");
+}
+
+// Counts are std::size_t, which is unsigned int on 32-bit targets (armhf) and std::uint64_t on
+// 64-bit ones: both read, and the narrow one refuses what it cannot hold.
+TEST(YamlMap, CountsReadAsSizeOnEveryTargetAndUnsignedIntRefusesWhatItCannotHold) {
+  YamlMap root =
+      YamlMap::from_string("sizes: [3, 4294967295]\nn: 7\nbig: 4294967296\nneg: -1\n", "C.yaml");
+  std::vector<std::size_t> sizes{};
+  root.read_sequence("sizes", sizes);
+  EXPECT_EQ(sizes, (std::vector<std::size_t>{3U, 4294967295U}));
+  EXPECT_EQ(root.required<unsigned int>("n"), 7U);
+  EXPECT_EQ(error_of([&] { static_cast<void>(root.required<unsigned int>("big")); }),
+            "C.yaml:3: big: expected a non-negative integer up to 4294967295, got '4294967296'");
+  EXPECT_EQ(error_of([&] { static_cast<void>(root.required<unsigned int>("neg")); }),
+            "C.yaml:4: neg: expected a non-negative integer, got '-1'");
 }
 
 TEST(YamlMap, SequencesNameTheirElements) {

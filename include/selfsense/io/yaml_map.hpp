@@ -39,6 +39,9 @@ void from_yaml(const YAML::Node& node, const std::string& where, double& out);
 void from_yaml(const YAML::Node& node, const std::string& where, int& out);
 void from_yaml(const YAML::Node& node, const std::string& where, std::int64_t& out);
 void from_yaml(const YAML::Node& node, const std::string& where, std::uint64_t& out);
+// std::size_t on 32-bit targets (armhf), where it is not std::uint64_t; values above its range
+// are refused.
+void from_yaml(const YAML::Node& node, const std::string& where, unsigned int& out);
 void from_yaml(const YAML::Node& node, const std::string& where, bool& out);
 void from_yaml(const YAML::Node& node, const std::string& where, std::string& out);
 

@@ -32,6 +32,7 @@
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <type_traits>
@@ -66,7 +67,7 @@ class SpscRing final {
       producer_.other_cached = consumer_.index.load(std::memory_order_acquire);
       if (head - producer_.other_cached >= capacity_) return false;
     }
-    slots_[head & mask_] = value;
+    slots_[slot(head)] = value;
     producer_.index.store(head + 1, std::memory_order_release);
     return true;
   }
@@ -78,7 +79,7 @@ class SpscRing final {
       consumer_.other_cached = producer_.index.load(std::memory_order_acquire);
       if (tail == consumer_.other_cached) return false;
     }
-    out = slots_[tail & mask_];
+    out = slots_[slot(tail)];
     consumer_.index.store(tail + 1, std::memory_order_release);
     return true;
   }
@@ -91,7 +92,7 @@ class SpscRing final {
     const auto available = static_cast<std::size_t>(consumer_.other_cached - tail);
     const std::size_t n = std::min(available, out.size());
     if (n == 0) return 0;
-    const auto first = static_cast<std::size_t>(tail & mask_);
+    const std::size_t first = slot(tail);
     const std::size_t before_wrap = std::min(n, capacity_ - first);
     std::copy_n(slots_.get() + first, before_wrap, out.data());
     std::copy_n(slots_.get(), n - before_wrap, out.data() + before_wrap);
@@ -117,7 +118,7 @@ class SpscRing final {
 
  private:
   static std::size_t round_up_pow2(std::size_t n) noexcept {
-    assert(n >= 1 && n <= (std::size_t{1} << 62U));
+    assert(n >= 1 && n <= std::numeric_limits<std::size_t>::max() / 2 + 1);
     std::size_t p = 1;
     while (p < n)
       p <<= 1U;
@@ -129,6 +130,11 @@ class SpscRing final {
     std::atomic<std::uint64_t> index{0};
     std::uint64_t other_cached{0};
   };
+
+  // The slot of a 64-bit index: below the capacity, so it fits std::size_t on 32-bit targets.
+  [[nodiscard]] std::size_t slot(std::uint64_t index) const noexcept {
+    return static_cast<std::size_t>(index & mask_);
+  }
 
   const std::size_t capacity_;
   const std::size_t mask_;
