@@ -16,7 +16,9 @@
 #                           amd64 (build/) and cross for arm64 and armhf (build-arm64/,
 #                           build-armhf/, cmake/toolchains/), cpack (cmake/SelfsensePackage.cmake):
 #                           build/packages/selfsense_VERSION_ARCH.deb and
-#                           libselfsense-dev_VERSION_ARCH.deb for the three architectures
+#                           libselfsense-dev_VERSION_ARCH.deb for the three architectures; an
+#                           architecture whose libraries apt cannot install here is built in a
+#                           Debian 12 root of its own (package_in_root)
 #   scripts/setup.sh port   install, the arm64 port alone as `test` proves it: cross-build, the
 #                           unit tests of label port under qemu-user, the arm64 packages read back
 #                           and installed in the arm64 VM (qemu-system-aarch64, scripts/vm/)
@@ -84,6 +86,9 @@ case $mode in
   package) cross_arches=(arm64 armhf) ;;
   test | port) cross_arches=(arm64) ;;
 esac
+# Inside a build root (package_in_root, below): that one architecture's packages only.
+root_arch=${SELFSENSE_ROOT_ARCH:-}
+[ -z "$root_arch" ] || { [ "$mode" = package ] && cross_arches=("$root_arch"); }
 declare -A cross_triplet=([arm64]=aarch64-linux-gnu [armhf]=arm-linux-gnueabihf)
 cross_packages() {  # cross_packages ARCH: the packages a cross build for ARCH needs
   local arch=$1
@@ -348,6 +353,49 @@ run_port() {
   say "port: arm64 built, tested under qemu-user, packaged and run in the arm64 VM in $((SECONDS - begin)) s"
 }
 
+# package_in_root ARCH: the ARCH packages built in a Debian 12 root of their own, where apt
+# cannot install ARCH's libraries beside this machine's. A Multi-Arch: same library (libc6,
+# liblzma5, ...) must have one version on every architecture; a machine that took a security
+# update whose ARCH build its mirror does not serve (bookworm-security's armhf index failing to
+# update, 2026-11-27/28) cannot install them. The root takes bookworm and bookworm-updates only
+# (every library at the archive's version on both architectures); it is made once by
+# debootstrap and kept outside the clone like the VM images (/var/cache/selfsense-roots, or
+# SELFSENSE_ROOTS). The clone is bound into it at its own path, so the build directory
+# (build-ARCH) and the packages (build/packages/) are the clone's; setup.sh runs there as
+# `package` for ARCH alone (SELFSENSE_ROOT_ARCH) and installs what it needs in the root.
+# Cold: about 2 minutes of debootstrap, 3 of apt and 10 of build on 2 cores.
+package_in_root() {
+  local arch=$1 base=${SELFSENSE_ROOTS:-/var/cache/selfsense-roots} mirror
+  local dir=$base/bookworm
+  as_root "the $arch packages need a build root"
+  command -v debootstrap >/dev/null || { export DEBIAN_FRONTEND=noninteractive; apt_update; apt-get install -y -q --no-install-recommends debootstrap; }
+  mirror=$(apt-get indextargets --format '$(REPO_URI)' 2>/dev/null | grep -E '/debian/$' | head -1 || true)
+  mirror=${mirror:-http://deb.debian.org/debian/}
+  if [ ! -x "$dir/usr/bin/apt-get" ]; then
+    say "package ($arch): a Debian 12 build root ($dir, debootstrap from $mirror)"
+    rm -rf "$dir.new"
+    mkdir -p "$base"
+    debootstrap --variant=minbase bookworm "$dir.new" "$mirror" >"$base/debootstrap.log" 2>&1 ||
+      { tail -20 "$base/debootstrap.log" >&2; echo "setup: debootstrap failed (log: $base/debootstrap.log)" >&2; exit 1; }
+    printf 'deb %s bookworm main\ndeb %s bookworm-updates main\n' "$mirror" "$mirror" >"$dir.new/etc/apt/sources.list"
+    mv "$dir.new" "$dir"
+  fi
+  say "package ($arch): built in the build root $dir"
+  cp /etc/resolv.conf "$dir/etc/resolv.conf"
+  mkdir -p "$dir$root"
+  (
+    mounted=()
+    trap 'for ((i = ${#mounted[@]} - 1; i >= 0; i--)); do umount "${mounted[$i]}"; done' EXIT
+    for m in /proc /sys /dev /dev/pts "$root"; do
+      mount --bind "$m" "$dir$m"
+      mounted+=("$dir$m")
+    done
+    # git (the version) runs as root on a clone another user may own.
+    chroot "$dir" /usr/bin/env SELFSENSE_ROOT_ARCH="$arch" GIT_CONFIG_COUNT=1 \
+      GIT_CONFIG_KEY_0=safe.directory GIT_CONFIG_VALUE_0="$root" bash "$root/scripts/setup.sh" package
+  )
+}
+
 # The cross architectures added before the first apt-get update, so that one update serves all.
 for arch in "${cross_arches[@]}"; do
   mapfile -t wanted < <(cross_packages "$arch")
@@ -440,14 +488,18 @@ case "$mode" in
   package)
     # The packaged programs and libraries only (target selfsense_packaged), in the same build
     # directory as demo and test: no test is built for it, and what they built is reused.
-    say "build: build (Release): the packaged programs and libraries"
-    launcher=$(compiler_launcher)
-    cmake -S . -B build -G Ninja ${launcher:+"$launcher"} -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=OFF \
-      "-DCMAKE_CXX_FLAGS_RELEASE=$release_flags"
-    cmake --build build -j "$jobs" --target selfsense_packaged
-    say "package: cpack (DEB) into build/packages/"
-    rm -f build/packages/*.deb
-    (cd build && cpack --config CPackConfig.cmake)
+    # Inside a build root only the cross architecture it was started for.
+    if [ -z "$root_arch" ]; then
+      say "build: build (Release): the packaged programs and libraries"
+      launcher=$(compiler_launcher)
+      cmake -S . -B build -G Ninja ${launcher:+"$launcher"} -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=OFF \
+        "-DCMAKE_CXX_FLAGS_RELEASE=$release_flags"
+      cmake --build build -j "$jobs" --target selfsense_packaged
+      say "package: cpack (DEB) into build/packages/"
+      rm -f build/packages/*.deb
+      (cd build && cpack --config CPackConfig.cmake)
+    fi
+    mkdir -p build/packages
     # The same for each cross architecture, in its own build directory (no test is configured),
     # its packages beside amd64's.
     for arch in "${cross_ready[@]}"; do
@@ -458,13 +510,17 @@ case "$mode" in
       (cd "build-$arch" && cpack --config CPackConfig.cmake)
       cp "build-$arch"/packages/*_"$arch".deb build/packages/
     done
-    ls -l build/packages/
-    if [ ${#cross_failed[@]} -ne 0 ]; then
-      echo "setup: no packages for ${cross_failed[*]}: their libraries could not be installed (apt" \
-        "above; a Multi-Arch: same library must have the build machine's version, which a mirror" \
-        "whose ${cross_failed[*]} index failed to update may not offer)" >&2
+    # An architecture whose libraries apt could not install here is built in a Debian 12 root
+    # of its own (package_in_root); inside one, a failure is final.
+    if [ -z "$root_arch" ]; then
+      for arch in "${cross_failed[@]}"; do
+        package_in_root "$arch"
+      done
+    elif [ ${#cross_failed[@]} -ne 0 ]; then
+      echo "setup: the $root_arch libraries could not be installed in the build root either (apt above)" >&2
       exit 1
     fi
+    ls -l build/packages/
     ;;
   port)
     [ ${#cross_failed[@]} -eq 0 ] || { echo "setup: cannot cross-build for arm64" >&2; exit 1; }
