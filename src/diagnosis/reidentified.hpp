@@ -176,6 +176,12 @@ namespace selfsense::diagnosis::detail {
 // terms replace the linear ones where they beat them on the held-out blocks (test and block
 // rule, no effect size: a nested model). Field-drive models with one side per channel; the
 // recording's temperature must move by more than 1 K.
+// Where the stack stays within 30 % of the temperature's recorded range of its first sample for
+// at least a fifth of the record (a ramp that starts late or slowly), the side is first
+// identified on that stretch only (at least a third of the record) and the terms on the whole
+// record: over the rest the side's slow creep lags would take in the drift as a slow response
+// to the drive, which the alternation does not undo (the fit barely changes along that valley).
+// Where that is not significant, or the stretch is shorter, the side sees the whole record.
 [[nodiscard]] std::optional<Reidentified> reidentified_temperature(
     const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
     const std::vector<double>& current, const Options& options);

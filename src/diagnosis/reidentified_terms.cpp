@@ -22,6 +22,16 @@ using identification::CorrectionTerm;
 
 constexpr int kAlternations = 3;  // terms, then side, each time on the other's latest
 
+// The temperature's side from the record's start (reidentified.hpp): the stretch where the
+// temperature stays within this share of its recorded range of the first sample's ...
+constexpr double kNearReferenceBand = 0.3;
+// ... used where it holds at least this share of the record (a stack near its reference long
+// enough to carry the side) ...
+constexpr double kMinNearReferenceShare = 0.2;
+// ... and the side identified on at least this share (the operators need the excitation's
+// variety more than the temperature's flatness).
+constexpr double kMinStartSideShare = 1.0 / 3.0;
+
 // The channel's side and a candidate's terms identified together.
 struct Joint {
   models::TransducerModel model{};
@@ -33,15 +43,20 @@ struct Joint {
 
 class Identifier {
  public:
-  Identifier(const models::TransducerModel& model, const Signals& s, const ChannelData& ch)
-      : model_(model), s_(s), ch_(ch) {}
+  // `side_samples`: the joint's side is identified on the record's first side_samples samples.
+  Identifier(const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
+             std::size_t side_samples)
+      : model_(model), s_(s), ch_(ch), side_samples_(side_samples) {}
 
-  // The structure's side of this channel identified on `channel` (the whole record).
-  [[nodiscard]] models::TransducerModel identify(std::span<const double> channel) const {
+  // The structure's side of this channel identified on the first `samples` samples of
+  // `channel` (all of them by default).
+  [[nodiscard]] models::TransducerModel identify(std::span<const double> channel,
+                                                 std::size_t samples = kAll) const {
+    const std::size_t k = std::min(samples, channel.size());
     identification::TransducerSignals t;
-    t.drive = s_.drive;
-    (ch_.sensed ? t.sensed : t.strain) = channel;
-    t.stress = s_.stress;
+    t.drive = s_.drive.first(k);
+    (ch_.sensed ? t.sensed : t.strain) = channel.first(k);
+    t.stress = s_.stress.empty() ? s_.stress : s_.stress.first(k);
     t.sample_time = s_.sample_time;
     return identification::identify(t, model_.structure,
                                     identification::defaults_for(model_.structure));
@@ -80,12 +95,12 @@ class Identifier {
     return out;
   }
 
-  // Alternates terms (fitted on `rows`) and the side (identified on the whole record with the
-  // terms undone). Throws as identification does.
+  // Alternates terms (fitted on `rows`) and the side (identified on its samples with the terms
+  // undone). Throws as identification does.
   [[nodiscard]] Joint joint(std::span<const CorrectionTerm> terms,
                             const std::vector<bool>& rows) const {
     Joint j;
-    j.model = identify(ch_.recorded);
+    j.model = identify(ch_.recorded, side_samples_);
     Joint best;
     for (int i = 0;; ++i) {
       j.base = output_of(j.model);
@@ -98,14 +113,16 @@ class Identifier {
       // the alternation need not descend, so the best pass on the fitting rows is kept.
       if (j.fit_sse < best.fit_sse) best = j;
       if (i == kAlternations) return best;
-      j.model = identify(undone(j.correction));
+      j.model = identify(undone(j.correction), side_samples_);
     }
   }
 
  private:
+  static constexpr std::size_t kAll = std::numeric_limits<std::size_t>::max();
   const models::TransducerModel& model_;
   const Signals& s_;
   const ChannelData& ch_;
+  std::size_t side_samples_;
 };
 
 const Candidate& temperature_candidate(bool quadratic) {
@@ -129,18 +146,16 @@ const Candidate* stress_candidate(const ChannelData& ch, const Signals& s) {
   return best;
 }
 
-// The side and a candidate's terms identified together (Identifier::joint), judged on held-out
-// blocks against the side identified on the record as it is. `ladder`: nested candidates, each
-// replacing the one before where it beats it on the held-out blocks (test and block rule, no
-// effect size: a nested model).
-std::optional<Reidentified> reidentified_with_terms(const models::TransducerModel& model,
-                                                    const Signals& s, const ChannelData& ch,
-                                                    const std::vector<double>& current,
-                                                    const Options& options,
-                                                    std::span<const Candidate* const> ladder,
-                                                    const std::string& judged) {
+// The side (on the first `side_samples` samples) and a candidate's terms identified together
+// (Identifier::joint), judged on held-out blocks against the side identified on the record as
+// it is. `ladder`: nested candidates, each replacing the one before where it beats it on the
+// held-out blocks (test and block rule, no effect size: a nested model).
+std::optional<Reidentified> reidentified_with_terms(
+    const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
+    const std::vector<double>& current, const Options& options,
+    std::span<const Candidate* const> ladder, const std::string& judged, std::size_t side_samples) {
   const std::size_t n = s.drive.size();
-  const Identifier id(model, s, ch);
+  const Identifier id(model, s, ch, side_samples);
   std::vector<double> null_output;
   Joint best;
   const Candidate* candidate = nullptr;
@@ -193,6 +208,16 @@ std::optional<Reidentified> reidentified_with_terms(const models::TransducerMode
   return r;
 }
 
+// The samples from the start while the temperature stays within kNearReferenceBand of its
+// range of the first sample's.
+std::size_t near_reference(std::span<const double> theta) {
+  const double band = kNearReferenceBand * range_of(theta);
+  std::size_t k = 0;
+  while (k < theta.size() && std::abs(theta[k] - theta[0]) <= band)
+    ++k;
+  return k;
+}
+
 // Field-drive models with one side for the channel.
 bool has_own_side(const models::TransducerModel& model, const ChannelData& ch) {
   const bool has_side = ch.sensed ? model.sensor.has_value() : model.actuator.has_value();
@@ -214,11 +239,31 @@ std::optional<Reidentified> reidentified_temperature(const models::TransducerMod
   if (ch.coupling != 0.0 && s.stress.empty()) return std::nullopt;
   const std::array<const Candidate*, 2> ladder{&temperature_candidate(false),
                                                &temperature_candidate(true)};
+  const std::string against = "against the structure identified on " + ch.name +
+                              " as recorded: the model had bent its own operators to the "
+                              "temperature)";
+  const std::size_t near = near_reference(s.temperature);
+  if (static_cast<double>(near) >= kMinNearReferenceShare * static_cast<double>(n)) {
+    const std::size_t side = std::max(
+        near, static_cast<std::size_t>(std::ceil(kMinStartSideShare * static_cast<double>(n))));
+    std::optional<Reidentified> r = reidentified_with_terms(
+        model, s, ch, current, options, ladder,
+        format("on held-out blocks (the model's structure identified on the record's first "
+               "%.0f s, the stack within %.0f %% of the temperature's range of its start for the "
+               "first %.0f s, with the temperature's terms undone, the terms fitted on the other "
+               "blocks of the whole record, ",
+               static_cast<double>(side) * s.sample_time, 100.0 * kNearReferenceBand,
+               static_cast<double>(near) * s.sample_time) +
+            against,
+        side);
+    if (r) return r;
+  }
   return reidentified_with_terms(
       model, s, ch, current, options, ladder,
       "on held-out blocks (the model's structure identified with the temperature's terms "
-      "undone, the terms fitted on the other blocks, against the structure identified on " +
-          ch.name + " as recorded: the model had bent its own operators to the temperature)");
+      "undone, the terms fitted on the other blocks, " +
+          against,
+      n);
 }
 
 std::optional<Reidentified> reidentified_stress_terms(const models::TransducerModel& model,
@@ -239,7 +284,8 @@ std::optional<Reidentified> reidentified_stress_terms(const models::TransducerMo
       model, s, ch, current, options, ladder,
       "on held-out blocks (the model's structure identified with the stress's terms undone, "
       "the terms fitted on the other blocks, against the structure identified on " +
-          ch.name + " as recorded: the model had bent its own operators to the stress)");
+          ch.name + " as recorded: the model had bent its own operators to the stress)",
+      n);
 }
 
 }  // namespace selfsense::diagnosis::detail
