@@ -209,6 +209,7 @@ void read_adaptation(YamlMap a, AdaptationSection& out) {
   a.read("stack_volume_m3", e.thermal.stack_volume_m3);
   a.read("max_power_w", e.thermal.max_power_w);
   a.read("use_temperature", out.use_temperature);
+  a.read("feedforward_estimate", out.feedforward_estimate);
   a.finish();
 }
 
@@ -349,6 +350,7 @@ runtime::LoopConfig DaemonConfig::loop_config() const {
   l.watchdog_s = safety.watchdog_s;
   l.status_period = loop.status_period_cycles;
   l.adaptation_temperature = adaptation.enabled && adaptation.use_temperature;
+  l.adaptation_feedforward_estimate = adaptation.enabled && adaptation.feedforward_estimate;
   l.health_enabled = health.enabled;
   l.health = health.estimator;
   l.health_bands = health.bands;

@@ -126,6 +126,8 @@ const std::array kTable{
     // `ctl adapt freeze|resume` freezes and resumes at run time.
     ReloadKey{"adaptation.enabled", kRefused, differs<&C::adaptation, &A::enabled>},
     ReloadKey{"adaptation.use_temperature", kRefused, differs<&C::adaptation, &A::use_temperature>},
+    ReloadKey{"adaptation.feedforward_estimate", kRefused,
+              differs<&C::adaptation, &A::feedforward_estimate>},
     ReloadKey{"adaptation.frozen", kRefused, differs<&C::adaptation, &A::estimator, &E::frozen>},
     ReloadKey{"adaptation.learn_loop", kRefused,
               differs<&C::adaptation, &A::estimator, &E::learn_loop>},

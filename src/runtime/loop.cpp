@@ -361,9 +361,11 @@ void Loop::cycle(bool overrun, std::int64_t missed) noexcept {
     predicted_d_ = adaptation::HealthEstimator::kNoPrediction;
     if (adapted_) adapted_->skip();
   }
-  // The feedforward follows a measured temperature through the model's fitted coefficients
-  // (the estimate from E and D alone is not fed to it: docs/adaptation.md).
-  if (temperature_measured && adapted_->has_temperature_coefficients()) {
+  // The feedforward's inverse follows the stack as adapted in this cycle: at a measured
+  // temperature through the model's fitted coefficients, and from the drift estimated from E
+  // and D when configured (docs/adaptation.md, "The feedforward with the adapted parameters").
+  const bool measured_ff = temperature_measured && adapted_->has_temperature_coefficients();
+  if (adapted_ && (measured_ff || config_.adaptation_feedforward_estimate)) {
     const adaptation::AdaptedReconstruction::FeedforwardScales g = adapted_->feedforward_scales();
     controller_.set_feedforward_scales(g.response, g.compliance);
   } else {

@@ -150,6 +150,23 @@ TEST(DaemonConfig, TheAdaptationSectionIsReadStrictlyAndValidated) {
   const ConfigResult temp_bad =
       load_sim("adapt-temp-bad", {{"use_temperature: false", "use_temperature: 3"}});
   EXPECT_TRUE(has(temp_bad, "adaptation.use_temperature")) << temp_bad.problems.front();
+  // The feedforward from the estimate: off as shipped, and only with the adaptation on.
+  EXPECT_FALSE(shipped.config.adaptation.feedforward_estimate);
+  EXPECT_FALSE(on.config.loop_config().adaptation_feedforward_estimate);
+  const ConfigResult ff =
+      load_sim("adapt-ff", {{"  enabled: false                # true: the loop",
+                             "  enabled: true                 # true: the loop"},
+                            {"feedforward_estimate: false", "feedforward_estimate: true"}});
+  ASSERT_TRUE(ff.ok()) << ff.problems.front();
+  EXPECT_TRUE(ff.config.adaptation.feedforward_estimate);
+  EXPECT_TRUE(ff.config.loop_config().adaptation_feedforward_estimate);
+  const ConfigResult ff_off =
+      load_sim("adapt-ff-off", {{"feedforward_estimate: false", "feedforward_estimate: true"}});
+  ASSERT_TRUE(ff_off.ok()) << ff_off.problems.front();
+  EXPECT_FALSE(ff_off.config.loop_config().adaptation_feedforward_estimate);
+  const ConfigResult ff_bad =
+      load_sim("adapt-ff-bad", {{"feedforward_estimate: false", "feedforward_estimate: 0.5"}});
+  EXPECT_TRUE(has(ff_bad, "adaptation.feedforward_estimate")) << ff_bad.problems.front();
 
   const ConfigResult bad = load_sim("adapt-bad", {{"memory_updates: 500", "memory_updates: 1"}});
   EXPECT_TRUE(has(bad, ".test-adapt-bad.yaml:")) << bad.problems.front();

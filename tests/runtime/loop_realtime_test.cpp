@@ -64,6 +64,7 @@ void every_mode_without_allocating(const models::TransducerModel& model, bool ad
   lc.strain_min = -1.0;
   lc.strain_max = 1.0;
   lc.adaptation_temperature = temperature;
+  lc.adaptation_feedforward_estimate = adapt;  // the estimate's scales into the feedforward
   if (health) {  // bands so narrow that alarms latch (as warnings) and resets clear them
     lc.health_enabled = true;
     lc.health.baseline_cycles = 2;

@@ -41,7 +41,12 @@
 //     process_noise_per_s, max_relative_change, reference_degc, permittivity_per_k,
 //     loop_per_k, coupling_per_k, compliance_per_k,
 //     load_stiffness_ratio              # adaptation::DriftEstimatorConfig's keys
+//     thermal_model, thermal_resistance_k_per_w, thermal_time_constant_s, ambient_degc,
+//     stack_volume_m3, max_power_w      # adaptation::ThermalModelConfig's keys
 //     use_temperature: false            # true: the driver's temp replaces the estimate
+//     feedforward_estimate: false       # true: the feedforward's inverse takes the actuator
+//                                       # adapted from the estimate too (not only a measured
+//                                       # temperature with fitted coefficients)
 //   health:                             # health from E and D, alarms (docs/health.md)
 //     enabled: false                    # true: the loop runs adaptation::HealthEstimator
 //     fault: false                      # true: an alarm is also a fault (safe output)
@@ -139,6 +144,10 @@ struct AdaptationSection {
   // (AdaptedReconstruction::set_temperature: with the model's fitted temperature coefficients,
   // docs/adaptation.md); in a cycle without it the estimate serves again.
   bool use_temperature{false};
+  // The feedforward's inverse takes the actuator adapted from the drift estimated from E and D
+  // too, not only at a measured temperature (runtime::LoopConfig::
+  // adaptation_feedforward_estimate).
+  bool feedforward_estimate{false};
   friend bool operator==(const AdaptationSection&, const AdaptationSection&) = default;
 };
 

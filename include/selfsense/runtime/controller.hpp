@@ -115,12 +115,18 @@ class Controller final {
   void swap_feedforward(Feedforward& next) noexcept;
   [[nodiscard]] std::size_t saturations() const noexcept { return saturations_; }
   // The stack's drift for the feedforward (adaptation::AdaptedReconstruction::
-  // feedforward_scales(): the actuator's operator response and compliance at the measured
-  // temperature over their values as identified). The inverse is applied to
+  // feedforward_scales(): the actuator's operator response and compliance as adapted, at a
+  // measured temperature or from the estimated drift, over their values as identified). The
+  // inverse is applied to
   //   (strain - compliance_scale s T_arm - y0) / response_scale
   // so the drifted actuator, response_scale times the identified operator, reaches the strain.
   // A scale that is not finite or outside [0.5, 2] is taken as 1. Real-time safe.
   void set_feedforward_scales(double response_scale, double compliance_scale) noexcept;
+  // The scales in use (after the bound above) [1].
+  [[nodiscard]] double feedforward_response_scale() const noexcept { return ff_response_scale_; }
+  [[nodiscard]] double feedforward_compliance_scale() const noexcept {
+    return ff_compliance_scale_;
+  }
 
  private:
   double feedforward(double strain) noexcept;

@@ -85,6 +85,13 @@ struct LoopConfig {
   // estimate in that cycle (AdaptedReconstruction::set_temperature; clear_temperature() in a
   // cycle without it).
   bool adaptation_temperature{false};
+  // With the adapted reconstruction the feedforward's inverse takes the adapted actuator
+  // (AdaptedReconstruction::feedforward_scales()) in every cycle with a measured temperature and
+  // a model with fitted coefficients; with this also from the drift estimated from E and D (the
+  // frozen drift while frozen). Otherwise, and without adaptation, the actuator as identified
+  // (scales 1). Off by default: on the daemon's bench the estimate's scales made the open loop's
+  // tracking worse (docs/adaptation.md, "The feedforward with the adapted parameters").
+  bool adaptation_feedforward_estimate{false};
   bool health_enabled{false};
   adaptation::HealthEstimatorConfig health{};
   adaptation::HealthBands health_bands{};

@@ -1,0 +1,104 @@
+#!/usr/bin/env bash
+# The main job's self-heating run (scripts/main_job.sh; config/heating-sim.yaml: a 200 Hz sine in
+# open loop warms the stack, then position steps) twice on fresh daemons with adaptation on:
+# `adaptation.feedforward_estimate: false` (as shipped: the feedforward's inverse as identified)
+# and `true` (its inverse at the drift estimated from E and D; docs/adaptation.md, "The
+# feedforward with the adapted parameters"). Per run, from the daemon's recording (armed rows),
+# one line: the stack's rise over the sine; true S against the setpoint over the sine in open
+# loop (RMS and mean, % of the setpoint's range there, which includes the rest before the sine);
+# true S on the settled position steps (main_job_report.sh's rule: 0.2 s after each step, % of
+# the setpoint's range).
+#   scripts/heating_feedforward.sh BUILD_DIR OUT_DIR [RUNS]   (RUNS pairs, default 1)
+set -euo pipefail
+build=${1:?usage: scripts/heating_feedforward.sh BUILD_DIR OUT_DIR [RUNS]}
+out=${2:?usage: scripts/heating_feedforward.sh BUILD_DIR OUT_DIR [RUNS]}
+runs=${3:-1}
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cli=$build/src/cli/selfsense
+daemon=$build/src/selfsensed/selfsensed
+mkdir -p "$out/config"
+out=$(cd "$out" && pwd)
+run_dir=$out
+# shellcheck source=scripts/daemon_runs.sh
+source "$root/scripts/daemon_runs.sh"
+ln -sfn "$root/config/models" "$out/config/models"
+ln -sfn "$root/config/plant" "$out/config/plant"
+config=$out/config/heating-feedforward.yaml
+pid=
+# start_daemon VALUE: heating-sim.yaml with this run's paths and feedforward_estimate: VALUE.
+start_daemon() {
+  sed -e "s|directory: ../build/[a-z-]*/recordings|directory: $out/recordings|" \
+    -e "s|path: ../build/[a-z-]*/control.sock|path: $out/control.sock|" \
+    -e "s|prometheus_file: ../build/[a-z-]*/selfsensed.prom|prometheus_file: $out/selfsensed.prom|" \
+    -e "s|^  feedforward_estimate: false|  feedforward_estimate: $1|" \
+    "$root/config/heating-sim.yaml" >"$config"
+  grep -q "^  feedforward_estimate: $1" "$config" || { echo "FAILED: no key to set" >&2; exit 1; }
+  "$cli" check-config "$config" >/dev/null
+  rm -f "$out/control.sock"
+  "$daemon" --config "$config" >>"$out/daemon.log" 2>&1 &
+  pid=$!
+  for _ in $(seq 100); do
+    [ -S "$out/control.sock" ] && break
+    sleep 0.1
+  done
+  [ -S "$out/control.sock" ] || { echo "FAILED: no socket: $(tail -5 "$out/daemon.log")" >&2; exit 1; }
+}
+stop_daemon() {
+  kill -TERM "$pid"
+  wait "$pid" || true
+  pid=
+}
+trap '[ -n "$pid" ] && kill -TERM "$pid" 2>/dev/null && wait "$pid" 2>/dev/null; rm -f "$config"' EXIT
+ctl() { "$cli" ctl --socket "$out/control.sock" "$@"; }
+# The run of scripts/main_job.sh (heating_run there), unchanged.
+awk 'BEGIN {
+  n = split("6.0e-4 1.5e-4 6.0e-4 1.05e-3 3.5e-4 8.0e-4", level, " ")
+  for (i = 1; i <= n; i++) for (k = 0; k < (i == 1 ? 67 : 267); k++) print level[i]
+}' >"$out/heating-steps.txt"
+heating_run() {
+  record_start "$1"
+  ctl wave sine --amplitude 4.5e-4 --offset 6.0e-4 --frequency 200 --repeat 3000 >/dev/null
+  hold 15
+  while [[ $(daemon_status) =~ \"wave_running\":true ]]; do hold 0.05; done
+  ctl mode position >/dev/null
+  ctl wave table --table "$out/heating-steps.txt" --dt 0.003 --repeat 1 >/dev/null
+  hold 4.3
+}
+# figures NAME FILE: the run's line (header comment).
+figures() {
+  awk -F, -v name="$1" '
+    /^#/ { next }
+    !header { header = 1; for (i = 1; i <= NF; i++) col[$i] = i; next }
+    $col["state"] != 2 { next }
+    {
+      n++; t[n] = $col["t"]; r[n] = $col["setpoint"]; x[n] = $col["S"]; mode[n] = $col["mode"]
+      temp[n] = $col["temp"]
+    }
+    END {
+      lo = hi = r[1]; last_jump = t[1]
+      for (i = 1; i <= n; i++) { if (r[i] < lo) lo = r[i]; if (r[i] > hi) hi = r[i] }
+      range = hi - lo
+      for (i = 1; i <= n; i++) {
+        if (mode[i] != 2) continue
+        sine_end = i; so++; e = x[i] - r[i]; ss += e * e; sm += e
+        if (!so_lo_set || r[i] < so_lo) so_lo = r[i]; if (!so_lo_set || r[i] > so_hi) so_hi = r[i]
+        so_lo_set = 1
+      }
+      for (i = 2; i <= n; i++) {
+        if ((r[i] - r[i - 1]) > 0.01 * range || (r[i - 1] - r[i]) > 0.01 * range) last_jump = t[i]
+        if (t[i] - last_jump < 0.2 || mode[i] != 0) continue
+        m++; ex += (x[i] - r[i]) ^ 2
+      }
+      printf "%s: rise %.1f K; sine in open loop: true S - setpoint %.3f %% RMS (mean %.3f %%) of %.4g; steps: true S %.3f %% RMS\n",
+             name, temp[sine_end] - temp[1], 100 * sqrt(ss / so) / (so_hi - so_lo),
+             100 * sm / so / (so_hi - so_lo), so_hi - so_lo, 100 * sqrt(ex / m) / range
+    }' "$2"
+}
+for i in $(seq "$runs"); do
+  for value in false true; do
+    start_daemon "$value"
+    watched_run "ff-$value-$i" open-loop heating_run >/dev/null
+    stop_daemon
+    figures "feedforward_estimate $value (pair $i)" "$(cat "$out/ff-$value-$i.path")"
+  done
+done
