@@ -1,6 +1,7 @@
 # shellcheck shell=bash
 # Runs of selfsensed in real time that watch the daemon's state: sourced (under
-# `set -euo pipefail`) by scripts/main_job.sh and by the tests that run the daemon in real time
+# `set -euo pipefail`) by scripts/main_job.sh, scripts/heating_feedforward.sh (both run
+# heating_run, below) and by the tests that run the daemon in real time
 # (tests/daemon/daemon_end_to_end.sh through the main job, tests/drivers/modbus/
 # modbus_end_to_end.sh, tests/daemon/main_job_faults.sh). The caller defines `ctl` (selfsense ctl
 # on its daemon's socket) and `run_dir` (where NAME.path and faults.txt are written).
@@ -127,4 +128,27 @@ watched_run() {
     fi
     echo "$name: repeating the run once (reset, re-arm, the whole run again)"
   done
+}
+
+# heating_run NAME: the main job's self-heating run (config/heating-sim.yaml; watched_run's
+# BODY, mode open-loop). A 200 Hz sine in open loop (3000 periods, 15 s of the loop's clock,
+# which a late cycle stretches) starts and ends at its offset; once it has ended, the position
+# mode holds there and a table plays the position run's staircase with edges of 3 ms (written
+# to run_dir/heating-steps.txt). (The heating configuration's shaper lets the setpoint move 1.0
+# per s, which the sine needs; a setpoint step at that slew takes 0.5 ms, one period of the
+# mount's 2 kHz resonance, which rings it. The edges of 3 ms come near the position run's, 9 ms
+# at 0.05 per s; each still moves the setpoint by more than 1 % of its range per sample, so the
+# figures take it for a step.)
+heating_run() {
+  awk 'BEGIN {
+    n = split("6.0e-4 1.5e-4 6.0e-4 1.05e-3 3.5e-4 8.0e-4", level, " ")
+    for (i = 1; i <= n; i++) for (k = 0; k < (i == 1 ? 67 : 267); k++) print level[i]
+  }' >"$run_dir/heating-steps.txt"
+  record_start "$1"
+  ctl wave sine --amplitude 4.5e-4 --offset 6.0e-4 --frequency 200 --repeat 3000 >/dev/null
+  hold 15
+  while [[ $(daemon_status) =~ \"wave_running\":true ]]; do hold 0.05; done
+  ctl mode position >/dev/null
+  ctl wave table --table "$run_dir/heating-steps.txt" --dt 0.003 --repeat 1 >/dev/null
+  hold 4.3
 }

@@ -50,20 +50,6 @@ stop_daemon() {
 }
 trap '[ -n "$pid" ] && kill -TERM "$pid" 2>/dev/null && wait "$pid" 2>/dev/null; rm -f "$config"' EXIT
 ctl() { "$cli" ctl --socket "$out/control.sock" "$@"; }
-# The run of scripts/main_job.sh (heating_run there), unchanged.
-awk 'BEGIN {
-  n = split("6.0e-4 1.5e-4 6.0e-4 1.05e-3 3.5e-4 8.0e-4", level, " ")
-  for (i = 1; i <= n; i++) for (k = 0; k < (i == 1 ? 67 : 267); k++) print level[i]
-}' >"$out/heating-steps.txt"
-heating_run() {
-  record_start "$1"
-  ctl wave sine --amplitude 4.5e-4 --offset 6.0e-4 --frequency 200 --repeat 3000 >/dev/null
-  hold 15
-  while [[ $(daemon_status) =~ \"wave_running\":true ]]; do hold 0.05; done
-  ctl mode position >/dev/null
-  ctl wave table --table "$out/heating-steps.txt" --dt 0.003 --repeat 1 >/dev/null
-  hold 4.3
-}
 # figures NAME FILE: the run's line (header comment).
 figures() {
   awk -F, -v name="$1" '

@@ -124,27 +124,7 @@ if [ -z "${SELFSENSE_MAIN_JOB_CONFIG:-}" ]; then
   segments+=(undamped damped)
 
   echo "== self-heating: a 200 Hz sine in open loop warms the stack, then position steps; with adaptation, then without"
-  # Each on a fresh daemon: its plant starts at 25 degC. The sine (3000 periods, 15 s of the
-  # loop's clock, which a late cycle stretches) starts and ends at its offset; once it has
-  # ended, the position mode holds there and a table plays the position run's staircase with
-  # edges of 3 ms. (The heating configuration's shaper lets the setpoint
-  # move 1.0 per s, which the sine needs; a setpoint step at that slew takes 0.5 ms, one period
-  # of the mount's 2 kHz resonance, which rings it. The edges of 3 ms come near the position
-  # run's, 9 ms at 0.05 per s; each still moves the setpoint by more than 1 % of its range per
-  # sample, so the figures take it for a step.)
-  awk 'BEGIN {
-    n = split("6.0e-4 1.5e-4 6.0e-4 1.05e-3 3.5e-4 8.0e-4", level, " ")
-    for (i = 1; i <= n; i++) for (k = 0; k < (i == 1 ? 67 : 267); k++) print level[i]
-  }' >"$out/heating-steps.txt"
-  heating_run() {
-    record_start "$1"
-    ctl wave sine --amplitude 4.5e-4 --offset 6.0e-4 --frequency 200 --repeat 3000 >/dev/null
-    hold 15
-    while [[ $(daemon_status) =~ \"wave_running\":true ]]; do hold 0.05; done
-    ctl mode position >/dev/null
-    ctl wave table --table "$out/heating-steps.txt" --dt 0.003 --repeat 1 >/dev/null
-    hold 4.3
-  }
+  # Each on a fresh daemon: its plant starts at 25 degC (heating_run: scripts/daemon_runs.sh).
   start_daemon "$root/config/heating-sim.yaml"
   watched_run heating-adapted open-loop heating_run
   ctl status --pretty >"$out/status-heating.json"
