@@ -16,40 +16,14 @@ runs=${3:-1}
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cli=$build/src/cli/selfsense
 daemon=$build/src/selfsensed/selfsensed
-mkdir -p "$out/config"
+mkdir -p "$out"
 out=$(cd "$out" && pwd)
 run_dir=$out
 # shellcheck source=scripts/daemon_runs.sh
 source "$root/scripts/daemon_runs.sh"
-ln -sfn "$root/config/models" "$out/config/models"
-ln -sfn "$root/config/plant" "$out/config/plant"
 config=$out/config/heating-feedforward.yaml
-pid=
-# start_daemon VALUE: heating-sim.yaml with this run's paths and feedforward_estimate: VALUE.
-start_daemon() {
-  sed -e "s|directory: ../build/[a-z-]*/recordings|directory: $out/recordings|" \
-    -e "s|path: ../build/[a-z-]*/control.sock|path: $out/control.sock|" \
-    -e "s|prometheus_file: ../build/[a-z-]*/selfsensed.prom|prometheus_file: $out/selfsensed.prom|" \
-    -e "s|^  feedforward_estimate: false|  feedforward_estimate: $1|" \
-    "$root/config/heating-sim.yaml" >"$config"
-  grep -q "^  feedforward_estimate: $1" "$config" || { echo "FAILED: no key to set" >&2; exit 1; }
-  "$cli" check-config "$config" >/dev/null
-  rm -f "$out/control.sock"
-  "$daemon" --config "$config" >>"$out/daemon.log" 2>&1 &
-  pid=$!
-  for _ in $(seq 100); do
-    [ -S "$out/control.sock" ] && break
-    sleep 0.1
-  done
-  [ -S "$out/control.sock" ] || { echo "FAILED: no socket: $(tail -5 "$out/daemon.log")" >&2; exit 1; }
-}
-stop_daemon() {
-  kill -TERM "$pid"
-  wait "$pid" || true
-  pid=
-}
-trap '[ -n "$pid" ] && kill -TERM "$pid" 2>/dev/null && wait "$pid" 2>/dev/null; rm -f "$config"' EXIT
-ctl() { "$cli" ctl --socket "$out/control.sock" "$@"; }
+# shellcheck source=scripts/daemon_process.sh
+source "$root/scripts/daemon_process.sh"
 # figures NAME FILE: the run's line (header comment).
 figures() {
   awk -F, -v name="$1" '
@@ -82,9 +56,15 @@ figures() {
 }
 for i in $(seq "$runs"); do
   for value in false true; do
-    start_daemon "$value"
+    start_daemon "$root/config/heating-sim.yaml" \
+      "s|^  feedforward_estimate: false|  feedforward_estimate: $value|" >/dev/null
+    # A shipped file without the key would run both halves of the pair alike: fail instead.
+    grep -q "^  feedforward_estimate: $value" "$config" || {
+      echo "FAILED: config/heating-sim.yaml has no feedforward_estimate to set" >&2
+      exit 1
+    }
     watched_run "ff-$value-$i" open-loop heating_run >/dev/null
-    stop_daemon
+    stop_daemon >/dev/null
     figures "feedforward_estimate $value (pair $i)" "$(cat "$out/ff-$value-$i.path")"
   done
 done
