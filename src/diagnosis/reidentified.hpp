@@ -127,7 +127,8 @@ struct CreepAndLeak {
 // structure identified on the whole record. Nothing is judged where the stress does not move
 // apart from the field (a constant preload: what a fit on E and the base's outputs leaves of T is
 // below 1e-9 of its magnitude), and nothing is returned where the structure identified on the
-// whole record fits a channel worse than the given model (a named one: by min_explains better).
+// whole record fits a channel worse than the given model; a named channel it fits by less than
+// min_explains better is no longer named (the others stay).
 // diagnose() calls it only where its first pass named nothing or nothing but stress, and takes
 // it only where it names a channel that pass did not.
 struct StressReidentified {

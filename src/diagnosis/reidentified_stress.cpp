@@ -193,17 +193,18 @@ std::optional<StressReidentified> reidentified_stress(const models::TransducerMo
     return std::nullopt;
   }
   // The identification's own evidence once more, for the model that replaces the given one: on
-  // the whole record it must fit no channel worse than that model, and each named channel by
-  // min_explains better (as each half did against the null).
+  // the whole record it must fit no channel worse than that model, and a named channel stays
+  // named only where it fits it by min_explains better (as each half did against the null).
   for (const ChannelData& ch : channels) {
     const std::vector<double> output = channel_of(r.outputs, ch);
     const double replaced_sse = sse_over(ch.recorded, ch.base, rows.judge);
     const double whole_sse = sse_over(ch.recorded, output, rows.judge);
-    const bool named = std::any_of(r.named.begin(), r.named.end(),
-                                   [&](const Finding& f) { return f.channel == ch.name; });
-    const double needed = named ? 1.0 - options.min_explains : 1.0;
-    if (!(whole_sse <= needed * replaced_sse)) return std::nullopt;
+    if (!(whole_sse <= replaced_sse)) return std::nullopt;
+    if (!(whole_sse <= (1.0 - options.min_explains) * replaced_sse)) {
+      std::erase_if(r.named, [&](const Finding& f) { return f.channel == ch.name; });
+    }
   }
+  if (r.named.empty()) return std::nullopt;
   std::vector<double> stress_mpa(n);
   for (std::size_t k = 0; k < n; ++k)
     stress_mpa[k] = 1e-6 * s.stress[k];
