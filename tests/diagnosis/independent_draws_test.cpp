@@ -354,7 +354,8 @@ const Mechanism kMechanisms[] = {
     // 27 % better (min_explains is 30 %), and that refused D's finding too: `consistent`
     // (validation D 0.056 %, clean 0.022 %). With the short channel left unnamed and D kept,
     // the stress is named on D; validation D falls to 0.049 % only (excess 0.79x, measured; the
-    // fitted terms carry to the validation's other preload no better), asserted at 0.9x.
+    // fitted structure carries to the validation's other preload little better than the bent
+    // base), asserted at 0.9x.
     {"StressNamedOnOneChannelIsNotRefusedByTheOther", Effect::kStress, 900006, 0.9},
     // Stress that changes the permittivity alone (k_eps 6.3e-9 /Pa), with an affine base
     // identified on the same recording: the stress-hysteresis structure forecast D worse than
