@@ -64,7 +64,12 @@ for i in $(seq "$runs"); do
       exit 1
     }
     watched_run "ff-$value-$i" open-loop heating_run >/dev/null
-    stop_daemon >/dev/null
+    # A daemon that exited with a fault must not leave its figures standing as a result.
+    stop_daemon >"$out/ff-$value-$i.stop"
+    grep -q "status 0$" "$out/ff-$value-$i.stop" || {
+      echo "FAILED: $(cat "$out/ff-$value-$i.stop") (pair $i, feedforward_estimate $value)" >&2
+      exit 1
+    }
     figures "feedforward_estimate $value (pair $i)" "$(cat "$out/ff-$value-$i.path")"
   done
 done
