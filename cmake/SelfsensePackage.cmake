@@ -34,6 +34,9 @@ set(_maintainer "${SELFSENSE_PACKAGE_MAINTAINER}")
 # The configurations, as installed: the model and the simulated bench from /usr/share/selfsense,
 # recordings, telemetry and the control socket where the unit's directories are.
 function(selfsense_package_config source destination)
+  # Written at configure time: a changed file must configure again, or the package keeps the old.
+  set_property(DIRECTORY ${PROJECT_SOURCE_DIR} APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS
+    ${PROJECT_SOURCE_DIR}/config/${source})
   file(READ ${PROJECT_SOURCE_DIR}/config/${source} _text)
   set(_before "${_text}")
   string(REGEX REPLACE "model: models/" "model: ${_share}/models/" _text "${_text}")
@@ -55,6 +58,8 @@ foreach(_example IN LISTS _examples)
 endforeach()
 
 # The unit, starting the packaged program.
+set_property(DIRECTORY ${PROJECT_SOURCE_DIR} APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS
+  ${PROJECT_SOURCE_DIR}/systemd/selfsensed.service)
 file(READ ${PROJECT_SOURCE_DIR}/systemd/selfsensed.service _unit)
 string(REPLACE "ExecStart=/usr/local/bin/selfsensed " "ExecStart=/usr/bin/selfsensed " _unit "${_unit}")
 if(NOT _unit MATCHES "\nExecStart=/usr/bin/selfsensed ")
