@@ -76,7 +76,7 @@ SignalConfig read_signal(io::YamlMap m, const std::string& key, std::size_t max_
 
 std::vector<FrameLayout> CanConfig::input_frames() const {
   std::vector<FrameLayout> frames;
-  for (const SignalConfig* s : {&e, &d, &s_ref, &t_ref}) {
+  for (const SignalConfig* s : {&e, &d, &s_ref, &t_ref, &temp}) {
     if (!s->present) continue;
     const std::size_t need = bytes_needed(s->signal);
     bool found = false;
@@ -121,6 +121,12 @@ void read_can_config(io::YamlMap& driver, double loop_rate_hz, CanConfig& out,
   if (out.priority < 0 || out.priority > 99) {
     problem("priority", std::to_string(out.priority) + " must be 0 (normal) or within [1, 99]");
   }
+  driver.read("temp_timeout_ms", out.temp_timeout_ms);
+  if (!(out.temp_timeout_ms >= period_ms && out.temp_timeout_ms <= 60000.0)) {
+    problem("temp_timeout_ms", std::to_string(out.temp_timeout_ms) +
+                                   " must be within [one loop period (" +
+                                   std::to_string(period_ms) + " ms), 60000]");
+  }
 
   io::YamlMap signals = driver.map("signals");
   const std::size_t max_bytes = out.max_bytes();
@@ -136,6 +142,7 @@ void read_can_config(io::YamlMap& driver, double loop_rate_hz, CanConfig& out,
   read("d", true, out.d);
   read("s_ref", false, out.s_ref);
   read("t_ref", false, out.t_ref);
+  read("temp", false, out.temp);
   read("command", true, out.command);
   signals.finish();
   if (signals.has("s_ref") != signals.has("t_ref")) {
@@ -144,10 +151,11 @@ void read_can_config(io::YamlMap& driver, double loop_rate_hz, CanConfig& out,
   }
 
   // Layout: no two signals of one frame share a bit; the command has a frame of its own.
-  const std::array<std::pair<const char*, const SignalConfig*>, 5> all{{{"e", &out.e},
+  const std::array<std::pair<const char*, const SignalConfig*>, 6> all{{{"e", &out.e},
                                                                         {"d", &out.d},
                                                                         {"s_ref", &out.s_ref},
                                                                         {"t_ref", &out.t_ref},
+                                                                        {"temp", &out.temp},
                                                                         {"command", &out.command}}};
   // Per frame, which signal owns each bit.
   std::map<std::pair<std::uint32_t, bool>, std::array<const char*, kFdMaxBytes * 8>> used;

@@ -56,16 +56,18 @@ bool CanDriver::configure(const runtime::DriverSetup& setup, std::string* why) {
   if (!config_.e.present || !config_.d.present || !config_.command.present) {
     return fail("driver.signals: e, d and command are required");
   }
-  const std::array<std::pair<const SignalConfig*, double runtime::InputSample::*>, 4> inputs{
+  const std::array<std::pair<const SignalConfig*, double runtime::InputSample::*>, 5> inputs{
       {{&config_.e, &runtime::InputSample::e},
        {&config_.d, &runtime::InputSample::d},
        {&config_.s_ref, &runtime::InputSample::s_ref},
-       {&config_.t_ref, &runtime::InputSample::t_ref}}};
+       {&config_.t_ref, &runtime::InputSample::t_ref},
+       {&config_.temp, &runtime::InputSample::temp_ref}}};
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const auto& [signal, field] = inputs.at(i);
     slots_.at(i) = Slot{*signal, signal->present ? bytes_needed(signal->signal) : 0, field};
   }
   rx_timeout_ns_ = static_cast<std::int64_t>(std::llround(config_.rx_timeout_ms * 1e6));
+  temp_timeout_ns_ = static_cast<std::int64_t>(std::llround(config_.temp_timeout_ms * 1e6));
   tx_ = canfd_frame{};
   tx_.can_id = wire_id(config_.command.frame);
   const std::size_t bytes = config_.frame_length(bytes_needed(config_.command.signal));
@@ -228,6 +230,7 @@ void CanDriver::on_frame(const canfd_frame& frame, std::int64_t now) noexcept {
     building_.sample.*s.field = decode(data, s.config.signal);
     if (s.field == &runtime::InputSample::e) building_.e_ns = now;
     if (s.field == &runtime::InputSample::d) building_.d_ns = now;
+    if (s.field == &runtime::InputSample::temp_ref) building_.temp_ns = now;
   }
   ++building_.sequence;
   building_.newest_ns = now;
@@ -253,6 +256,10 @@ runtime::DriverStatus CanDriver::read(runtime::InputSample& out) noexcept {
     }
   }
   out = last_.sample;
+  if (config_.temp.present && (last_.temp_ns == 0 || now - last_.temp_ns > temp_timeout_ns_)) {
+    out.temp_ref = runtime::InputSample::kNone;
+    bump(n_.temp_timeouts);
+  }
   const bool bus_off = bus_off_.load(std::memory_order_relaxed);
   out.device_status = static_cast<std::uint16_t>(
       (bus_off ? kStatusBusOff : 0U) |
@@ -395,6 +402,7 @@ runtime::DriverCounters CanDriver::counters() const noexcept {
   c.add_event("bus_off", get(n_.bus_off));
   c.add_event("command_saturated", get(n_.saturated));
   c.add_event("commands_superseded", get(n_.superseded));
+  c.add_event("temp_timeouts", get(n_.temp_timeouts));
   return c;
 }
 

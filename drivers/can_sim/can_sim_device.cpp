@@ -1,6 +1,7 @@
 // The simulated transducer as a CAN node: receives the command frame, steps the plant in real
 // time with the command held between frames (zero-order hold, like a DAC) and sends the input
-// frames (E, D and, when the layout has them, the reference S and T) every period, encoded with
+// frames (E, D and, when the layout has them, the reference S and T and the stack's temperature:
+// 25 degC plus the plant's self-heating) every period, encoded with
 // the layout of the daemon's own configuration (include/selfsense/drivers/can/can_codec.hpp), so
 // both ends agree by construction.
 //
@@ -86,14 +87,14 @@ std::optional<int> plant_substeps(const CanSimDeviceOptions& options, std::strin
 // One input frame to send and the signals it carries.
 struct OutFrame {
   canfd_frame frame{};
-  std::vector<std::pair<const can::SignalConfig*, int>> signals{};  // signal, channel 0..3
+  std::vector<std::pair<const can::SignalConfig*, int>> signals{};  // signal, channel 0..4
 };
 
 // The input frames of the layout, each with the signals it carries (pointers into layout).
 std::vector<OutFrame> input_frames(const can::CanConfig& layout) {
   std::vector<OutFrame> frames;
-  const std::array<const can::SignalConfig*, 4> channels{&layout.e, &layout.d, &layout.s_ref,
-                                                         &layout.t_ref};
+  const std::array<const can::SignalConfig*, 5> channels{&layout.e, &layout.d, &layout.s_ref,
+                                                         &layout.t_ref, &layout.temp};
   for (const can::FrameLayout& f : layout.input_frames()) {
     OutFrame out;
     out.frame.can_id = wire_id(f.id);
@@ -151,15 +152,15 @@ class CanNode final {
       ++counts_.command_timeouts;
     }
   }
-  // One device period of the plant with the command held: E, D, S, T.
-  std::array<double, 4> step_plant() {
+  // One device period of the plant with the command held: E, D, S, T, temperature.
+  std::array<double, 5> step_plant() {
     const plant::StepInput input{timed_out_ ? 0.0 : command_, 0.0, 25.0};
     plant::StepOutput o{};
     for (int i = 0; i < substeps_; ++i)
       o = plant_.step(input);
-    return {o.e_meas_v_per_m, o.d_meas_c_per_m2, o.s, o.t_pa};
+    return {o.e_meas_v_per_m, o.d_meas_c_per_m2, o.s, o.t_pa, o.temp_degc};
   }
-  void send_inputs(const std::array<double, 4>& values);
+  void send_inputs(const std::array<double, 5>& values);
 
   const can::CanConfig* layout_;
   int fd_;
@@ -204,7 +205,7 @@ void CanNode::drain_commands(std::int64_t now) {
   }
 }
 
-void CanNode::send_inputs(const std::array<double, 4>& values) {
+void CanNode::send_inputs(const std::array<double, 5>& values) {
   for (OutFrame& f : frames_) {
     const std::span<std::uint8_t> data(f.frame.data, f.frame.len);
     for (const auto& [signal, channel] : f.signals) {

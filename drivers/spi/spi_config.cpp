@@ -97,6 +97,30 @@ std::vector<std::string> SpiConfig::problems(double loop_rate_hz) const {
         "d.feedback_capacitance_f: " + num(d.feedback_capacitance_f) + " must be > 0");
   check(std::abs(e.offset_v) < 1.2, "e.offset_v: must be within (-1.2, 1.2) V");
   check(std::abs(d.offset_v) < 1.2, "d.offset_v: must be within (-1.2, 1.2) V");
+  if (temp.wired) {
+    check(temp.channel >= 0 && temp.channel <= 3, "temp.channel: must be 0..3");
+    check(temp.channel != e.channel && temp.channel != d.channel,
+          "temp.channel: " + std::to_string(temp.channel) +
+              " is also the channel of E or D (the temperature needs its own input)");
+    check(power_of_two_up_to_128(temp.pga_gain),
+          "temp.pga_gain: " + std::to_string(temp.pga_gain) + " is not one of 1, 2, 4, ..., 128");
+    check(std::isfinite(temp.volts_per_degc) && temp.volts_per_degc != 0.0,
+          "temp.volts_per_degc: " + num(temp.volts_per_degc) + " must be finite and not 0");
+    check(std::abs(temp.volts_at_0_degc) < 100.0,
+          "temp.volts_at_0_degc: must be within (-100, 100) V");
+    const bool ordered = temp.range_degc[0] < temp.range_degc[1];
+    check(ordered, "temp.range_degc: needs min < max");
+    if (ordered && power_of_two_up_to_128(temp.pga_gain) && std::isfinite(temp.volts_per_degc)) {
+      // Like E's: the whole range must be measurable, both ends inside the ADC's full scale.
+      const double fs = 1.2 / temp.pga_gain;
+      for (const double theta : temp.range_degc) {
+        const double v = temp.volts_at_0_degc + temp.volts_per_degc * theta;
+        check(std::abs(v) < fs, "temp.range_degc: " + num(theta) + " degC is " + num(v) +
+                                    " V at the ADC, outside its full scale +-" + num(fs) +
+                                    " V (narrow the range or lower temp.pga_gain)");
+      }
+    }
+  }
   check(e.range_v_per_m[0] < e.range_v_per_m[1], "e.range_v_per_m: needs min < max");
   check(d.range_c_per_m2[0] < d.range_c_per_m2[1], "d.range_c_per_m2: needs min < max");
   check(std::isfinite(amplifier.gain_v_per_v) && amplifier.gain_v_per_v > 0.0,
@@ -209,6 +233,15 @@ void read_spi_config(io::YamlMap& driver, double loop_rate_hz, SpiConfig& out,
   read_range(d, "range_c_per_m2", out.d.range_c_per_m2);
   d.finish();
 
+  if (auto th = driver.optional_map("temp")) {
+    out.temp.wired = true;
+    th->read("channel", out.temp.channel);
+    th->read("pga_gain", out.temp.pga_gain);
+    th->read("volts_at_0_degc", out.temp.volts_at_0_degc);
+    th->read("volts_per_degc", out.temp.volts_per_degc);
+    read_range(*th, "range_degc", out.temp.range_degc);
+    th->finish();
+  }
   if (auto a = driver.optional_map("amplifier")) {
     a->read("gain_v_per_v", out.amplifier.gain_v_per_v);
     a->read("input_offset_v", out.amplifier.input_offset_v);

@@ -125,6 +125,9 @@ bool SpiDriver::initialise_adc(std::string* why) noexcept {
   std::array<std::uint8_t, 4> gains{};
   gains.at(static_cast<std::size_t>(config_.e.channel)) = gain_code(config_.e.pga_gain);
   gains.at(static_cast<std::size_t>(config_.d.channel)) = gain_code(config_.d.pga_gain);
+  if (config_.temp.wired) {
+    gains.at(static_cast<std::size_t>(config_.temp.channel)) = gain_code(config_.temp.pga_gain);
+  }
   // MODE: 24-bit words, SPI timeout on, STATUS.RESET cleared (written 0), DRDY on the most
   // lagging channel as a level, input CRC as configured.
   const std::uint16_t mode = static_cast<std::uint16_t>(
@@ -281,6 +284,17 @@ runtime::DriverStatus SpiDriver::read(runtime::InputSample& out) noexcept {
   const std::int32_t d_code = r.code.at(cd);
   out.e = config_.field_of(adc::volts(e_code, config_.e.pga_gain));
   out.d = config_.displacement_of(adc::volts(d_code, config_.d.pga_gain));
+  if (config_.temp.wired) {
+    // Slow and auxiliary: a bad reading is no temperature this cycle (counted), not a fault.
+    const std::int32_t code = r.code.at(static_cast<std::size_t>(config_.temp.channel));
+    const double theta = config_.temperature_of(adc::volts(code, config_.temp.pga_gain));
+    if (code < adc::kCodeMax && code > adc::kCodeMin && std::isfinite(theta) &&
+        theta >= config_.temp.range_degc[0] && theta <= config_.temp.range_degc[1]) {
+      out.temp_ref = theta;
+    } else {
+      bump(n_.temp_out_of_range);
+    }
+  }
   const std::uint16_t drdy = static_cast<std::uint16_t>((1U << ce) | (1U << cd));
   if ((status & drdy) != drdy) {
     bump(n_.no_new_data);
@@ -419,6 +433,7 @@ runtime::DriverCounters SpiDriver::counters() const noexcept {
   c.add_event("adc_resets", s.adc_resets);
   c.add_event("reinit_failures", s.reinit_failures);
   c.add_event("reinits", s.reinits);
+  c.add_event("temp_out_of_range", s.temp_out_of_range);
   return c;
 }
 
@@ -439,6 +454,7 @@ SpiCounters SpiDriver::spi_counters() const noexcept {
   c.adc_resets = get(n_.adc_resets);
   c.reinit_failures = get(n_.reinit_failures);
   c.reinits = get(n_.reinits);
+  c.temp_out_of_range = get(n_.temp_out_of_range);
   return c;
 }
 

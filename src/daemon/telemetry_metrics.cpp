@@ -1,5 +1,6 @@
 #include "selfsense/daemon/telemetry_metrics.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <set>
 #include <string>
@@ -52,6 +53,12 @@ std::vector<MetricFamily> loop_metrics(const runtime::StatusSnapshot& s) {
                   T::kCounter, static_cast<double>(s.saturations)));
   f.push_back(one("selfsense_loop_model_swaps_total", "Models swapped in while running.",
                   T::kCounter, static_cast<double>(s.model_swaps)));
+  // Only while the driver measures it (none: the series ends rather than reading NaN).
+  if (std::isfinite(s.last.temp_ref)) {
+    f.push_back(one("selfsense_stack_temperature_celsius",
+                    "The stack's temperature as the driver measures it.", T::kGauge,
+                    s.last.temp_ref));
+  }
   MetricFamily faults{"selfsense_loop_faults_total",
                       "Cycles in which each fault's cause was seen (status fault_details count).",
                       T::kCounter,

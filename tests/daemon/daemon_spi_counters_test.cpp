@@ -57,7 +57,11 @@ TEST(DaemonSpiCounters, CrcErrorsReachTheStatusAndTheTextfile) {
 
   // The emulated hardware; the daemon owns a driver of its own on it (maintenance by nobody:
   // two CRC errors stay below crc_errors_to_reinit).
-  test::SpiBench bench(test::emulated_spi_config(kRate), test::daemon_plant(kRate));
+  // The stack's temperature wired on channel 2 (docs/drivers/spi.md, `temp`).
+  drivers::spi::SpiConfig spi = test::emulated_spi_config(kRate);
+  spi.temp.wired = true;
+  test::SpiBench bench(spi, test::daemon_plant(kRate));
+  bench.ambient_degc = 31.5;
   auto driver = std::make_unique<drivers::spi::SpiDriver>(
       bench.config,
       drivers::spi::SpiHardware{&bench.adc, &bench.dac, &bench.adc.drdy_line(), &bench.enable,
@@ -99,7 +103,11 @@ TEST(DaemonSpiCounters, CrcErrorsReachTheStatusAndTheTextfile) {
   EXPECT_EQ(c.at("driver_bad_data"), 2);
   EXPECT_EQ(c.at("driver_events").at("crc_errors"), 2);
   EXPECT_EQ(c.at("driver_events").at("input_crc_errors"), 0);
-  EXPECT_EQ(c.at("driver_events").size(), 12U);
+  EXPECT_EQ(c.at("driver_events").size(), 13U);
+  EXPECT_EQ(c.at("driver_events").at("temp_out_of_range"), 0);
+  // The temperature as the driver reads it, in the status and the textfile.
+  EXPECT_NEAR(status.at("estimate").at("temp").get<double>(), 31.5, 1e-3) << status.dump();
+  EXPECT_NEAR(x.samples.at("selfsense_stack_temperature_celsius").at(""), 31.5, 1e-3);
   EXPECT_GT(c.at("driver_reads").get<long long>(), 100);
   EXPECT_TRUE(c.contains("driver_writes"));
   const nlohmann::json& fault = status.at("fault_details").at("driver_error");

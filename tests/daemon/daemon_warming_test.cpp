@@ -95,7 +95,9 @@ Errors errors_of(const std::filesystem::path& dir) {
 // then 6 s more at 45 degC, recorded; the errors and the final equivalent temperature. With
 // use_temperature the simulated driver's temperature channel replaces the estimate
 // (adaptation.use_temperature).
-Errors warming_run(bool adapt, double* equivalent_degc, bool use_temperature = false) {
+// measured_degc: the driver's temperature as `status` shows it at the end (estimate.temp).
+Errors warming_run(bool adapt, double* equivalent_degc, bool use_temperature = false,
+                   double* measured_degc = nullptr) {
   const testing::ScratchDir dir(use_temperature ? "daemon-warming-temperature"
                                 : adapt         ? "daemon-warming-adapted"
                                                 : "daemon-warming-plain");
@@ -113,6 +115,7 @@ Errors warming_run(bool adapt, double* equivalent_degc, bool use_temperature = f
     const nlohmann::json s = daemon.status();
     EXPECT_EQ(s["state"], "armed") << s.dump();
     if (adapt) *equivalent_degc = s["adaptation"]["temperature_degc"].get<double>();
+    if (measured_degc != nullptr) *measured_degc = s["estimate"].value("temp", -273.15);
     EXPECT_TRUE(daemon.request(R"({"request": "record", "action": "stop"})").value("ok", false));
     EXPECT_EQ(daemon.terminate(), 0);
   }
@@ -145,7 +148,8 @@ TEST(DaemonAdaptation, TheSelfSensedStrainHoldsWhileTheStackWarms) {
 // the shipped model carries no fitted ones). Beside the figures above without it.
 TEST(DaemonAdaptation, TheTemperatureChannelTracksTheWarmingStack) {
   double reported = 0.0;
-  const Errors measured = warming_run(true, &reported, true);
+  double shown = 0.0;
+  const Errors measured = warming_run(true, &reported, true, &shown);
   std::printf(
       "warming 25 -> 45 degC, %g Hz loop, the temperature channel: S_hat nrmse %.3f %% (last "
       "fifth %.3f %%), T_hat %.3f %% (%.3f %%); temperature reported at the end %.2f degC "
@@ -157,6 +161,7 @@ TEST(DaemonAdaptation, TheTemperatureChannelTracksTheWarmingStack) {
   EXPECT_LT(measured.s_last_nrmse, 1.3 * kMeasuredChannelLastS);
   EXPECT_LT(measured.t_last_nrmse, 1.3 * kMeasuredChannelLastT);
   EXPECT_NEAR(reported, 45.0, 0.1);  // the plant's own temperature, as the driver reads it
+  EXPECT_NEAR(shown, 45.0, 0.1) << "status estimate.temp";
 }
 
 }  // namespace

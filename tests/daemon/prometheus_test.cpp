@@ -187,6 +187,13 @@ TEST(Prometheus, TelemetryFamiliesAreValidExposition) {
   EXPECT_EQ(x.types.at("selfsense_driver_events_total"), "counter");
   EXPECT_EQ(x.types.at("selfsense_loop_faults_total"), "counter");
   EXPECT_EQ(x.types.at("selfsense_loop_cycles"), "gauge");
+  // No temperature measured (the sample's is NaN): no series, rather than a NaN.
+  EXPECT_EQ(x.samples.count("selfsense_stack_temperature_celsius"), 0U);
+  s.last.temp_ref = 41.25;
+  const test::Exposition warm = test::check_exposition(format_exposition(loop_metrics(s)));
+  EXPECT_TRUE(warm.problems.empty()) << joined(warm.problems);
+  EXPECT_EQ(warm.samples.at("selfsense_stack_temperature_celsius").at(""), 41.25);
+  EXPECT_EQ(warm.types.at("selfsense_stack_temperature_celsius"), "gauge");
 }
 
 }  // namespace

@@ -52,20 +52,47 @@ TEST(CanConfig, ShippedConfigurationLoadsWithItsLayout) {
   EXPECT_EQ(c.s_ref.signal.start_bit, 7U);
   EXPECT_EQ(c.command.frame, (can::FrameId{0x18FF0001, true}));
   EXPECT_TRUE(c.has_references());
+  EXPECT_TRUE(c.has_temperature());
+  EXPECT_EQ(c.temp.frame, (can::FrameId{0x103, false}));
+  EXPECT_EQ(c.temp.signal.length, 16U);
+  EXPECT_TRUE(c.temp.signal.is_signed);
+  EXPECT_EQ(c.temp.signal.scale, 0.01);
+  EXPECT_EQ(c.temp_timeout_ms, 1000.0);
   const std::vector<can::FrameLayout> frames = c.input_frames();
-  ASSERT_EQ(frames.size(), 2U);
+  ASSERT_EQ(frames.size(), 3U);
   EXPECT_EQ(frames[0].bytes, 8U);
   EXPECT_EQ(frames[1].bytes, 8U);
+  EXPECT_EQ(frames[2].id, (can::FrameId{0x103, false}));
+  EXPECT_EQ(frames[2].bytes, 2U);
   const auto driver = registry.create();
   ASSERT_NE(driver, nullptr);
   EXPECT_EQ(driver->name(), "can");
   EXPECT_TRUE(driver->has_references());
+  EXPECT_TRUE(driver->has_temperature());
+}
+
+TEST(CanConfig, TheTemperatureIsOptional) {
+  Registry registry;
+  const ConfigResult r = load_with({{"    temp: {id: 0x103", "    # temp: {id: 0x103"},
+                                    {"           scale: 0.01}", "           # scale: 0.01}"}},
+                                   registry);
+  ASSERT_TRUE(r.ok()) << joined(r);
+  EXPECT_FALSE(registry.can_config().has_temperature());
+  EXPECT_EQ(registry.can_config().input_frames().size(), 2U);
+  const auto driver = registry.create();
+  ASSERT_NE(driver, nullptr);
+  EXPECT_FALSE(driver->has_temperature());
 }
 
 TEST(CanConfig, EveryMistakeIsNamedByItsKey) {
   const std::vector<std::pair<std::pair<std::string, std::string>, std::string>> cases{
       {{"interface: vcan0 ", "interface: a-very-long-name0 "}, "driver.interface: "},
       {{"rx_timeout_ms: 50 ", "rx_timeout_ms: 0.5 "}, "driver.rx_timeout_ms: "},
+      {{"temp_timeout_ms: 1000 ", "temp_timeout_ms: 90000 "}, "driver.temp_timeout_ms: "},
+      {{"temp: {id: 0x103, byte: 0", "temp: {id: 0x102, byte: 0"},
+       "driver.signals.temp: overlaps signal s_ref in frame 0x102"},
+      {{"temp: {id: 0x103, byte: 0, length: 16", "temp: {id: 0x103, byte: 0, length: 80"},
+       "driver.signals.temp.length: "},
       {{"byte: 4, length: 32", "byte: 2, length: 32"},
        "driver.signals.d: overlaps signal e in frame 0x101"},
       {{"byte: 4, length: 32", "byte: 5, length: 32"}, "driver.signals.d.byte: "},

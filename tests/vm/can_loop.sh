@@ -13,6 +13,7 @@ vm_check_test "${1:?usage: tests/vm/can_loop.sh OUT_DIR}" can_loop \
   'check_config=ok' \
   'state_armed="armed"' \
   'position_reached=yes' \
+  'temperature_shown=yes .*' \
   'bad_data_counted=yes .*' \
   'error_frame_counted=yes .*' \
   'state_after_injection="armed"' \
@@ -25,6 +26,7 @@ vm_check_test "${1:?usage: tests/vm/can_loop.sh OUT_DIR}" can_loop \
   'timeouts_counted=yes .*' \
   'state_after_kill="faulted"' \
   'fault=driver_timeout' \
+  'temp_timeouts_counted=yes .*' \
   'command_after_kill=0(\.0)?' \
   'daemon_exit=0' \
   'candump_frames=yes .*' \

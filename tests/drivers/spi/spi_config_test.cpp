@@ -53,6 +53,28 @@ TEST(SpiConfig, ShippedConfigurationLoadsAndBuildsTheDriver) {
   EXPECT_NEAR(c.field_of(1.0), 125.0 / 60e-6, 1e-3);
   EXPECT_NEAR(c.displacement_of(-1.0), 330e-6 / (167 * 25e-6), 1e-12);
   EXPECT_NEAR(c.dac_volts_of(2e6), 2e6 * 60e-6 / 30.0, 1e-12);
+  EXPECT_TRUE(c.temp.wired);
+  EXPECT_EQ(c.temp.channel, 2);
+  EXPECT_NEAR(c.temperature_of(0.25 + 0.005 * 42.0), 42.0, 1e-9);
+  EXPECT_TRUE(driver->has_temperature());
+}
+
+TEST(SpiConfig, TheTemperatureChannelIsOptional) {
+  Registry registry;
+  const ConfigResult r = load_with({{"  temp:  ", "  temp_unwired:  "}}, registry);
+  EXPECT_NE(joined(r).find("temp_unwired"), std::string::npos) << joined(r);
+  Registry none;
+  const ConfigResult ok =
+      load_with({{"  temp:  ", "  # temp:  "},
+                 {"    channel: 2 ", "    # channel: 2 "},
+                 {"    pga_gain: 1\n    volts_at_0_degc", "    # pga_gain: 1\n    volts_at_0_degc"},
+                 {"    volts_at_0_degc: 0.25 ", "    # volts_at_0_degc: 0.25 "},
+                 {"    volts_per_degc: 0.005 ", "    # volts_per_degc: 0.005 "},
+                 {"    range_degc: ", "    # range_degc: "}},
+                none);
+  ASSERT_TRUE(ok.ok()) << joined(ok);
+  EXPECT_FALSE(none.spi_config().temp.wired);
+  EXPECT_FALSE(none.create()->has_temperature());
 }
 
 TEST(SpiConfig, ProblemsNameTheirKeys) {
@@ -70,6 +92,13 @@ TEST(SpiConfig, ProblemsNameTheirKeys) {
        "driver.d.range_c_per_m2: 0.09 C/m^2"},
       {{"clkin_hz: 5120000", "clkin_hz: 9000000"}, "driver.adc.clkin_hz: 9e+06 must be within"},
       {{"full_scale_v: 5.0", "full_scale_v: -1"}, "driver.dac.full_scale_v: -1 must be within"},
+      {{"channel: 2 ", "channel: 1 "}, "driver.temp.channel: 1 is also the channel of E or D"},
+      {{"volts_per_degc: 0.005", "volts_per_degc: 0.01"},
+       "driver.temp.range_degc: 150 degC is 1.75 V at the ADC, outside its full scale"},
+      {{"volts_per_degc: 0.005", "volts_per_degc: 0.0"},
+       "driver.temp.volts_per_degc: 0 must be finite and not 0"},
+      {{"range_degc: [-40.0, 150.0]", "range_degc: [150.0, -40.0]"},
+       "driver.temp.range_degc: needs min < max"},
   };
   for (const auto& [edit, expected] : cases) {
     Registry registry;

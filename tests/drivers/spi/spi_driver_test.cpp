@@ -1,8 +1,9 @@
 // The SPI driver against the chip emulators at its SpiBus / GpioLine seam, in simulated time:
 // set-up with read-back verification, the samples' scaling through the front end, the DAC
 // frames, every fault path (CRC errors, re-initialisation, stuck data, missing conversions,
-// clipped and out-of-range inputs, the amplifier's fault line, a dead bus), data-ready pacing,
-// and no allocation or lock on the real-time path.
+// clipped and out-of-range inputs, the amplifier's fault line, a dead bus), the stack's
+// temperature on a spare channel, data-ready pacing, and no allocation or lock on the real-time
+// path.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -116,6 +117,54 @@ TEST(SpiDriver, SamplesAreScaledThroughTheFrontEnd) {
   EXPECT_EQ(f.bench->driver.counters().writes, 20U);
 }
 
+// A linear sensor (0.25 V + 5 mV/K at the ADC, the defaults) on channel 2: the stack's temperature
+// from the same frame as E and D; a reading beyond the ADC's full scale or outside range_degc is no
+// temperature (NaN, counted) and not a fault.
+TEST(SpiDriver, TheStackTemperatureIsReadFromItsOwnChannel) {
+  drivers::spi::SpiConfig c = emulated_spi_config(kRate);
+  c.temp.wired = true;
+  c.temp.range_degc = {-40.0, 60.0};
+  Fixture f(c);
+  ASSERT_TRUE(f.start());
+  EXPECT_TRUE(f.bench->driver.has_temperature());
+  f.bench->ambient_degc = 37.5;
+  for (int k = 0; k < 5; ++k)
+    ASSERT_EQ(f.cycle(), DriverStatus::kOk) << k;
+  // One LSB is 1.2 V / 2^23 / 5 mV/K = 2.9e-5 K.
+  EXPECT_NEAR(f.in.temp_ref, 37.5, 1e-4);
+  EXPECT_EQ(f.bench->driver.spi_counters().temp_out_of_range, 0U);
+  f.bench->ambient_degc = 65.0;  // 0.575 V: inside the full scale, outside range_degc
+  EXPECT_EQ(f.cycle(), DriverStatus::kOk);
+  EXPECT_TRUE(std::isnan(f.in.temp_ref));
+  EXPECT_TRUE(std::isfinite(f.in.e));
+  f.bench->ambient_degc = 250.0;  // 1.5 V: clipped at the ADC
+  EXPECT_EQ(f.cycle(), DriverStatus::kOk);
+  EXPECT_TRUE(std::isnan(f.in.temp_ref));
+  EXPECT_EQ(f.bench->driver.spi_counters().temp_out_of_range, 2U);
+  EXPECT_EQ(f.bench->driver.counters().bad_data, 0U);
+  f.bench->ambient_degc = -12.25;
+  EXPECT_EQ(f.cycle(), DriverStatus::kOk);
+  EXPECT_NEAR(f.in.temp_ref, -12.25, 1e-4);
+
+  // Its PGA gain reaches the gain register beside E's and D's (gain 4: code 2 in bits 8..10).
+  drivers::spi::SpiConfig gained = c;
+  gained.temp.pga_gain = 4;
+  gained.temp.range_degc = {-40.0, 5.0};  // 0.275 V at 5 degC, of 0.3 V full scale
+  Fixture g(gained);
+  std::string why;
+  ASSERT_TRUE(g.start(&why)) << why;
+  EXPECT_EQ(g.bench->adc.reg(adc::kRegGain), 0x0200);
+  g.bench->ambient_degc = 2.0;
+  EXPECT_EQ(g.cycle(), DriverStatus::kOk);
+  EXPECT_NEAR(g.in.temp_ref, 2.0, 1e-4);
+
+  Fixture none;  // without the section: no temperature, whatever the spare channel reads
+  ASSERT_TRUE(none.start());
+  EXPECT_FALSE(none.bench->driver.has_temperature());
+  EXPECT_EQ(none.cycle(), DriverStatus::kOk);
+  EXPECT_TRUE(std::isnan(none.in.temp_ref));
+}
+
 TEST(SpiDriver, CrcErrorsAreCountedFaultsAndThreeInARowReinitialiseTheAdc) {
   Fixture f;
   ASSERT_TRUE(f.start());
@@ -154,10 +203,10 @@ TEST(SpiDriver, CountersCarryEveryCauseAsANamedEvent) {
   EXPECT_EQ(f.cycle(), DriverStatus::kOk);
   const runtime::DriverCounters c = f.bench->driver.counters();
   EXPECT_EQ(c.crc_errors, 2U);
-  const std::vector<std::string> names{"crc_errors",   "input_crc_errors", "clipped",
-                                       "out_of_range", "no_new_data",      "stuck",
-                                       "drdy_missed",  "command_clipped",  "amp_faults",
-                                       "adc_resets",   "reinit_failures",  "reinits"};
+  const std::vector<std::string> names{
+      "crc_errors",      "input_crc_errors", "clipped",          "out_of_range", "no_new_data",
+      "stuck",           "drdy_missed",      "command_clipped",  "amp_faults",   "adc_resets",
+      "reinit_failures", "reinits",          "temp_out_of_range"};
   ASSERT_EQ(c.event_list().size(), names.size());
   for (std::size_t i = 0; i < names.size(); ++i) {
     ASSERT_NE(c.events[i].name, nullptr);

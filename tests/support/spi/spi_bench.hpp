@@ -1,9 +1,10 @@
 // The SPI driver's bench in simulated time: the simulated transducer (selfsense::plant) behind
-// its analog front end (HV divider onto ADC channel e, charge amplifier onto channel d, the HV
-// amplifier driven by the DAC), an ADS131M04 and a DAC8563 emulator at the SpiBus seam,
-// emulated enable and fault lines, and the driver on them (maintenance run by the test through
-// service()). The plant steps once per ADC conversion with the field the DAC commands, so the
-// loop closes through the same frames and codes as on hardware.
+// its analog front end (HV divider onto ADC channel e, charge amplifier onto channel d, a linear
+// temperature sensor onto channel temp when wired, the HV amplifier driven by the DAC), an
+// ADS131M04 and a DAC8563 emulator at the SpiBus seam, emulated enable and fault lines, and the
+// driver on them (maintenance run by the test through service()). The plant steps once per ADC
+// conversion with the field the DAC commands, so the loop closes through the same frames and codes
+// as on hardware.
 #pragma once
 
 #include <array>
@@ -52,7 +53,7 @@ struct SpiBench {
     const double h = config.transducer.layer_thickness_m;
     const double u = config.amplifier.gain_v_per_v *
                      (dac.volts(config.dac.output) - config.amplifier.input_offset_v);
-    last = plant.step({u / h, 0.0, 25.0});
+    last = plant.step({u / h, 0.0, ambient_degc});
     std::array<double, 4> v{};
     v.at(static_cast<std::size_t>(config.e.channel)) =
         last.e_meas_v_per_m * h / config.e.divider + config.e.offset_v;
@@ -60,6 +61,10 @@ struct SpiBench {
         last.d_meas_c_per_m2 * config.transducer.layers * config.transducer.electrode_area_m2;
     v.at(static_cast<std::size_t>(config.d.channel)) =
         (config.d.inverting ? -q : q) / config.d.feedback_capacitance_f + config.d.offset_v;
+    if (config.temp.wired) {
+      v.at(static_cast<std::size_t>(config.temp.channel)) =
+          config.temp.volts_at_0_degc + config.temp.volts_per_degc * last.temp_degc;
+    }
     return v;
   }
 
@@ -67,6 +72,7 @@ struct SpiBench {
   runtime::SimulatedClock clock{};
   plant::Plant plant;
   plant::StepOutput last{};
+  double ambient_degc{25.0};  // the plant's temperature input (the stack's, without heating)
   Dac8563Emulator dac;
   Ads131m04Emulator adc;
   EmulatedLine enable{false};

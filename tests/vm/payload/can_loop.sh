@@ -4,7 +4,8 @@
 # interface, both as this build's selfsense package installs them with apt (lib/package.sh;
 # /usr/bin, Debian's libraries), on its example /etc/selfsense/examples/can-sim.yaml and the
 # plant under /usr/share/selfsense, run as plain processes beside can-utils. Checks that the loop, armed in position mode through
-# `selfsense ctl`, brings S_hat to the setpoint; that candump sees the input and command frames;
+# `selfsense ctl`, brings S_hat to the setpoint; that the stack's temperature arrives in its own
+# frame and reaches the status; that candump sees the input and command frames;
 # that a short input frame and an error frame injected with cansend are counted (and do not
 # stop the loop); that killing the node gives timeout faults and the safe output (E = 0 on the
 # bus); then the same over CAN FD (MTU 72). Prints "name=value" lines that
@@ -99,6 +100,9 @@ echo "position_reached=$reached"
 echo "s_hat=$(field S_hat "$status") s_true=$(field S "$status") setpoint=$(field setpoint "$status")"
 [ "$reached" = yes ] || fail "S_hat did not reach $target: $status"
 echo "overruns=$(field overruns "$status") cycles=$(field cycles "$status")"
+# The node sends the plant's temperature (25 degC plus its self-heating) in frame 0x103.
+temp=$(field temp "$status")
+echo "temperature_shown=$(awk -v t="$temp" 'BEGIN { exit !(t + 0 >= 24.9 && t + 0 < 100) }' && echo yes || echo no) ($temp degC)"
 before_bad=$(field driver_bad_data "$status")
 before_err=$(field driver_errors "$status")
 
@@ -139,6 +143,8 @@ sleep 1
 status=$(ctl status)
 timeouts=$(field driver_timeouts "$status")
 echo "timeouts_counted=$([ "$timeouts" -gt "$before_timeouts" ] && echo yes || echo no) ($before_timeouts -> $timeouts)"
+# No temperature frame for temp_timeout_ms (1 s): none is read (counted), not a fault of its own.
+echo "temp_timeouts_counted=$([ "$(field temp_timeouts "$status")" -gt 0 ] && echo yes || echo no) (temp $(field temp "$status"))"
 echo "state_after_kill=$(field state "$status")"
 grep -q '"faults":\[[^]]*"driver_timeout"' <<<"$status" && echo "fault=driver_timeout"
 echo "command_after_kill=$(field command "$status")"
@@ -151,8 +157,9 @@ kill "$dump" 2>/dev/null || true
 wait "$dump" 2>/dev/null || true
 inputs=$(grep -c ' vcanl0 101#' "$work/candump.log" || true)
 refs=$(grep -c ' vcanl0 102#' "$work/candump.log" || true)
+temps=$(grep -c ' vcanl0 103#' "$work/candump.log" || true)
 commands=$(grep -c ' vcanl0 18FF0001#' "$work/candump.log" || true)
-echo "candump_frames=$([ "$inputs" -gt 100 ] && [ "$refs" -gt 100 ] && [ "$commands" -gt 100 ] && echo yes || echo no) (101: $inputs, 102: $refs, 18FF0001: $commands)"
+echo "candump_frames=$([ "$inputs" -gt 100 ] && [ "$refs" -gt 100 ] && [ "$temps" -gt 100 ] && [ "$commands" -gt 100 ] && echo yes || echo no) (101: $inputs, 102: $refs, 103: $temps, 18FF0001: $commands)"
 echo "candump_injected=$(grep -cE ' vcanl0 (101#01|20000004#0004000000000000|20000040#0000000000000000)$' "$work/candump.log")"
 # The last command on the bus is the safe output, E = 0.
 echo "last_command=$(grep ' vcanl0 18FF0001#' "$work/candump.log" | tail -1 | awk '{ print $3 }')"

@@ -1,6 +1,7 @@
 // The CAN driver's section of the daemon's configuration: the interface, timing limits and the
-// signal definitions (as a DBC file gives them) of the inputs E, D (optional S_ref, T_ref) and of
-// the command. Read strictly from YAML; every problem names its key. Not real-time code.
+// signal definitions (as a DBC file gives them) of the inputs E, D (optional S_ref, T_ref and the
+// stack's temperature) and of the command. Read strictly from YAML; every problem names its key.
+// Not real-time code.
 //
 //   driver:
 //     type: can
@@ -10,7 +11,9 @@
 //     stale_cycles: 0           # this many reads in a row without a new input frame: stale; 0 off
 //     error_frames: true        # subscribe to error frames (counted; bus-off disconnects)
 //     priority: 0               # the bus thread's SCHED_FIFO priority (1..99); 0: normal
-//     signals:                  # e, d, command required; s_ref and t_ref together or not at all
+//     temp_timeout_ms: 1000     # a temperature older than this reads as none (NaN), not a fault
+//     signals:                  # e, d, command required; s_ref and t_ref together or not at all;
+//                               # temp [degC] optional (the recording's `temp` column)
 //       e: {id: 0x101, extended: false, start_bit: 0, length: 32, byte_order: little,
 //           signed: true, scale: 1.0, offset: 0.0}
 //       ...                     # `byte: N` instead of start_bit: the signal starts at byte N
@@ -45,17 +48,20 @@ struct CanConfig {
   std::uint32_t stale_cycles{0};
   bool error_frames{true};
   int priority{0};  // bus thread SCHED_FIFO priority; 0: normal scheduling
+  double temp_timeout_ms{1000.0};
   SignalConfig e{};
   SignalConfig d{};
   SignalConfig s_ref{};
   SignalConfig t_ref{};
+  SignalConfig temp{};  // the stack's temperature [degC]
   SignalConfig command{};
 
   [[nodiscard]] std::size_t max_bytes() const noexcept {
     return fd ? kFdMaxBytes : kClassicMaxBytes;
   }
   [[nodiscard]] bool has_references() const noexcept { return s_ref.present && t_ref.present; }
-  // The distinct frames that carry inputs, in the order e, d, s_ref, t_ref first name them.
+  [[nodiscard]] bool has_temperature() const noexcept { return temp.present; }
+  // The distinct frames that carry inputs, in the order e, d, s_ref, t_ref, temp first name them.
   [[nodiscard]] std::vector<FrameLayout> input_frames() const;
   // Data length of a frame carrying these bytes on this bus (an FD length when fd).
   [[nodiscard]] std::size_t frame_length(std::size_t bytes) const noexcept;

@@ -1,4 +1,5 @@
-// The SocketCAN driver of the loop (runtime::Driver): the inputs E, D (and S_ref, T_ref) arrive
+// The SocketCAN driver of the loop (runtime::Driver): the inputs E, D (and S_ref, T_ref, the
+// stack's temperature) arrive
 // in CAN or CAN FD frames laid out as the configuration's signal definitions say (can_config.hpp,
 // codec in can_codec.hpp); the command E leaves in a frame of its own. docs/drivers/can.md.
 //
@@ -18,7 +19,10 @@
 // Statuses of read(): kTimeout when E or D is older than rx_timeout_ms (or never arrived),
 // kDisconnected while the controller is bus-off (from a CAN_ERR_BUSOFF error frame until
 // CAN_ERR_RESTARTED, or until an input frame arrives after read() has reported the bus-off), kStale
-// after stale_cycles reads in a row without a new input frame (0: off), kOk otherwise.
+// after stale_cycles reads in a row without a new input frame (0: off), kOk otherwise. A
+// temperature older than temp_timeout_ms (or none yet) is read as NaN and counted
+// (temp_timeouts), not a fault: it is slow and the loop runs without it (the adaptation learns
+// from E and D alone in such cycles).
 //
 // Counters (DriverCounters): reads, writes (command frames sent by the bus thread), errors
 // (error frames received and failed sends), timeouts, stale (reads that returned those),
@@ -26,7 +30,7 @@
 // on a full TX queue), reconnects (recoveries from bus-off), device_faults (bus-off events),
 // crc_errors (error frames reporting a protocol violation in the CRC sequence or delimiter).
 // Events (DriverCounters::events): rx_frames, error_frames, tx_errors, tx_queue_full,
-// rx_timeouts, bus_off_reads, bus_off, command_saturated, commands_superseded.
+// rx_timeouts, bus_off_reads, bus_off, command_saturated, commands_superseded, temp_timeouts.
 #pragma once
 
 #include <linux/can.h>
@@ -71,6 +75,7 @@ struct CanInputs {
   std::uint64_t sequence{0};  // input frames accepted so far
   std::int64_t e_ns{0};       // arrival of the newest E (0: none yet)
   std::int64_t d_ns{0};
+  std::int64_t temp_ns{0};    // arrival of the newest temperature (0: none yet)
   std::int64_t newest_ns{0};  // arrival of the newest input frame
 };
 
@@ -90,6 +95,7 @@ class CanDriver final : public runtime::Driver {
   runtime::DriverStatus write(const runtime::OutputCommand& command) noexcept override;
   void deactivate() noexcept override;
   [[nodiscard]] bool has_references() const noexcept override { return config_.has_references(); }
+  [[nodiscard]] bool has_temperature() const noexcept override { return config_.has_temperature(); }
   [[nodiscard]] runtime::DriverCounters counters() const noexcept override;
   [[nodiscard]] CanCounters can_counters() const noexcept;
 
@@ -121,8 +127,9 @@ class CanDriver final : public runtime::Driver {
   bool send_frame(double e) noexcept;
 
   CanConfig config_;
-  std::array<Slot, 4> slots_{};
+  std::array<Slot, 5> slots_{};
   std::int64_t rx_timeout_ns_{0};
+  std::int64_t temp_timeout_ns_{0};
   int socket_{-1};
   int wake_fd_{-1};  // eventfd: write() wakes the bus thread
   bool priority_granted_{true};
@@ -155,7 +162,7 @@ class CanDriver final : public runtime::Driver {
   struct Atomics {
     std::atomic<std::uint64_t> reads{0}, writes{0}, tx_errors{0}, timeouts{0}, stale{0},
         bad_data{0}, retries{0}, reconnects{0}, bus_off{0}, rx_frames{0}, error_frames{0},
-        saturated{0}, disconnected{0}, superseded{0}, crc_errors{0};
+        saturated{0}, disconnected{0}, superseded{0}, crc_errors{0}, temp_timeouts{0};
   };
   Atomics n_{};
   std::atomic<bool> bus_off_{false};

@@ -15,6 +15,10 @@
 //        q = -+(v - offset_v) * C_f,  D = q / (layers * electrode_area)   (charge amplifier)
 //   amplifier: {gain_v_per_v, input_offset_v}
 //        u = gain * (v_dac - input_offset_v),  E = u / layer_thickness   (the HV amplifier)
+//   temp: {channel, pga_gain, volts_at_0_degc, volts_per_degc, range_degc: [lo, hi]}   optional
+//        theta = (v - volts_at_0_degc) / volts_per_degc   (a linear analog sensor on the stack,
+//        e.g. 0.5 V + 10 mV/K behind a 2:1 divider; absent: no temperature, the recording has no
+//        `temp` column)
 //   gpio: {chip, drdy: {line}, enable: {line, active_low}, fault: {line, active_low}}
 //   faults: {stale_frames, stuck_frames, crc_errors_to_reinit, transfer_errors_to_reinit,
 //            reinit_backoff_s: [min, max]}
@@ -76,6 +80,17 @@ struct ChargeChannel {  // D: the charge amplifier onto an ADC input
   std::array<double, 2> range_c_per_m2{-0.02, 0.09};
 };
 
+// The stack's temperature: a linear analog sensor (a silicon sensor's output, or a thermistor
+// or RTD behind a linearising front end) onto a spare ADC input, sampled with E and D.
+struct TemperatureChannel {
+  bool wired{false};  // the section is present
+  int channel{2};
+  int pga_gain{1};
+  double volts_at_0_degc{0.25};  // a 0.5 V + 10 mV/K sensor behind a 2:1 divider: 150 degC
+  double volts_per_degc{0.005};  // is 1.0 V, inside the +-1.2 V full scale at gain 1
+  std::array<double, 2> range_degc{-40.0, 150.0};  // outside: no temperature that cycle
+};
+
 struct AmplifierConfig {
   double gain_v_per_v{30.0};
   double input_offset_v{0.0};
@@ -108,6 +123,7 @@ struct SpiConfig {
   Transducer transducer{};
   FieldChannel e{};
   ChargeChannel d{};
+  TemperatureChannel temp{};
   AmplifierConfig amplifier{};
   GpioConfig gpio{};
   FaultConfig faults{};
@@ -122,6 +138,9 @@ struct SpiConfig {
   [[nodiscard]] double displacement_of(double v) const noexcept {
     const double q = (d.inverting ? -1.0 : 1.0) * (v - d.offset_v) * d.feedback_capacitance_f;
     return q / (static_cast<double>(transducer.layers) * transducer.electrode_area_m2);
+  }
+  [[nodiscard]] double temperature_of(double v) const noexcept {
+    return (v - temp.volts_at_0_degc) / temp.volts_per_degc;
   }
   [[nodiscard]] double dac_volts_of(double field) const noexcept {
     return field * transducer.layer_thickness_m / amplifier.gain_v_per_v + amplifier.input_offset_v;

@@ -33,6 +33,9 @@
 //   kStale         no new conversion for more than stale_frames frames in a row (STATUS.DRDY),
 //                  or the E and D codes unchanged for stuck_frames frames (a stuck converter)
 //   kOk            otherwise
+// With a `temp` channel, InputSample::temp_ref is the stack's temperature from the same frame;
+// a clipped reading or one outside temp.range_degc leaves it NaN (counted: temp_out_of_range)
+// and does not change the status: the loop runs on without a temperature that cycle.
 // write() statuses: kNotActive, kDisconnected (the DAC transfer failed), kOk. A command beyond
 // the DAC's range is clamped to it and counted; a non-finite command writes E = 0.
 //
@@ -65,18 +68,19 @@ namespace selfsense::drivers::spi {
 
 // The causes behind DriverCounters, for the documentation, the status and the tests.
 struct SpiCounters {
-  std::uint64_t crc_errors{0};        // ADC frames whose CRC did not match
-  std::uint64_t input_crc_errors{0};  // frames of ours the ADC rejected (STATUS.CRC_ERR)
-  std::uint64_t clipped{0};           // E or D code at the ADC's full scale
-  std::uint64_t out_of_range{0};      // E or D not finite or outside its range
-  std::uint64_t no_new_data{0};       // frames without a new conversion (STATUS.DRDY clear)
-  std::uint64_t stuck{0};             // reads answered kStale for unchanged codes
-  std::uint64_t drdy_missed{0};       // data-ready edges the loop was too late for
-  std::uint64_t command_clipped{0};   // commands beyond the DAC's range
-  std::uint64_t amp_faults{0};        // amplifier fault line assertions
-  std::uint64_t adc_resets{0};        // STATUS.RESET seen while running
-  std::uint64_t reinit_failures{0};   // failed re-initialisation attempts
-  std::uint64_t reinits{0};           // successful re-initialisations
+  std::uint64_t crc_errors{0};         // ADC frames whose CRC did not match
+  std::uint64_t input_crc_errors{0};   // frames of ours the ADC rejected (STATUS.CRC_ERR)
+  std::uint64_t clipped{0};            // E or D code at the ADC's full scale
+  std::uint64_t out_of_range{0};       // E or D not finite or outside its range
+  std::uint64_t no_new_data{0};        // frames without a new conversion (STATUS.DRDY clear)
+  std::uint64_t stuck{0};              // reads answered kStale for unchanged codes
+  std::uint64_t drdy_missed{0};        // data-ready edges the loop was too late for
+  std::uint64_t command_clipped{0};    // commands beyond the DAC's range
+  std::uint64_t amp_faults{0};         // amplifier fault line assertions
+  std::uint64_t adc_resets{0};         // STATUS.RESET seen while running
+  std::uint64_t reinit_failures{0};    // failed re-initialisation attempts
+  std::uint64_t reinits{0};            // successful re-initialisations
+  std::uint64_t temp_out_of_range{0};  // temperature readings clipped, outside range_degc: none
 };
 
 // The hardware the driver talks to, not owned. Tests give chip emulators; the one-argument
@@ -115,6 +119,9 @@ class SpiDriver final : public runtime::Driver, private runtime::CycleTrigger {
   // The safe output on the DAC, the amplifier disabled, the thread stopped, the hardware closed.
   void deactivate() noexcept override;
   [[nodiscard]] runtime::DriverCounters counters() const noexcept override;
+  // With a `temp` section: read() fills temp_ref [degC] (NaN when the reading is clipped or
+  // outside range_degc; counted, not a fault).
+  [[nodiscard]] bool has_temperature() const noexcept override { return config_.temp.wired; }
   [[nodiscard]] runtime::CycleTrigger* cycle_trigger() noexcept override {
     return config_.pace == Pace::kDrdy && active_ ? this : nullptr;
   }
@@ -194,7 +201,7 @@ class SpiDriver final : public runtime::Driver, private runtime::CycleTrigger {
     std::atomic<std::uint64_t> reads{0}, writes{0}, errors{0}, timeouts{0}, stale{0}, bad_data{0},
         crc_errors{0}, input_crc_errors{0}, clipped{0}, out_of_range{0}, no_new_data{0}, stuck{0},
         drdy_missed{0}, command_clipped{0}, amp_faults{0}, adc_resets{0}, reinit_failures{0},
-        reinits{0};
+        reinits{0}, temp_out_of_range{0};
   };
   Atomics n_{};
 };
