@@ -106,8 +106,7 @@ std::vector<std::string> SpiConfig::problems(double loop_rate_hz) const {
           "temp.pga_gain: " + std::to_string(temp.pga_gain) + " is not one of 1, 2, 4, ..., 128");
     check(std::isfinite(temp.volts_per_degc) && temp.volts_per_degc != 0.0,
           "temp.volts_per_degc: " + num(temp.volts_per_degc) + " must be finite and not 0");
-    check(std::abs(temp.volts_at_0_degc) < 100.0,
-          "temp.volts_at_0_degc: must be within (-100, 100) V");
+    check(std::isfinite(temp.volts_at_0_degc), "temp.volts_at_0_degc: must be finite");
     const bool ordered = temp.range_degc[0] < temp.range_degc[1];
     check(ordered, "temp.range_degc: needs min < max");
     if (ordered && power_of_two_up_to_128(temp.pga_gain) && std::isfinite(temp.volts_per_degc)) {

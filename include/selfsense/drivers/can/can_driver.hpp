@@ -1,7 +1,7 @@
 // The SocketCAN driver of the loop (runtime::Driver): the inputs E, D (and S_ref, T_ref, the
-// stack's temperature) arrive
-// in CAN or CAN FD frames laid out as the configuration's signal definitions say (can_config.hpp,
-// codec in can_codec.hpp); the command E leaves in a frame of its own. docs/drivers/can.md.
+// stack's temperature) arrive in CAN or CAN FD frames laid out as the configuration's signal
+// definitions say (can_config.hpp, codec in can_codec.hpp); the command E leaves in a frame of its
+// own. docs/drivers/can.md.
 //
 // Threads. activate() opens a raw CAN socket (bound to the interface, filtered to the input
 // frames and, when enabled, error frames) and starts the bus thread: it blocks in poll() with a
