@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string_view>
 
 #include "text.hpp"
@@ -82,12 +83,33 @@ void describe_dynamics(Finding& f, const Evidence& e) {
   const Signals& s = e.s;
   const std::string& n = e.ch.name;
   const std::string& tail = e.tail;
-  f.evidence = "the recorded " + n +
-               format(
-                   " rings and lags at fast changes like a resonance at %.4g Hz with %.2g "
-                   "damping (inertia of stack and load)",
-                   c.dynamics_frequency_hz, c.dynamics_damping) +
-               tail;
+  // Below its frequency the second-order low-pass is 1 - (2 zeta / w0) s + ((4 zeta^2 - 1) /
+  // w0^2) s^2 + ..., a delay tau = 2 zeta / w0 is 1 - tau s + (tau^2 / 2) s^2 + ...: at zeta =
+  // 1/sqrt(2) they agree to second order, and from there up the low-pass has no resonant peak.
+  // Such a fit is a lag of the channel, as an acquisition chain's anti-aliasing filter and
+  // sampling lag it (Butterworth 0.71, Bessel 0.87), not a mechanical mode: named a delay. Its
+  // lag is the stage's filter's at DC (bilinear, prewarped at f0): zeta Ts / tan(w0 Ts / 2),
+  // 2 zeta / w0 well below Nyquist.
+  if (c.dynamics_damping >= kNoResonanceDamping) {
+    const double omega = 2.0 * std::numbers::pi * c.dynamics_frequency_hz;
+    const double lag_s = c.dynamics_damping * s.sample_time / std::tan(omega * s.sample_time / 2.0);
+    f.effect = "delay";
+    f.evidence = "the recorded " + n +
+                 format(
+                     " lags the model by %.3g samples (%.3g ms) and is smoothed above the "
+                     "excitation's band, without resonance: channels sampled out of step ",
+                     lag_s / s.sample_time, lag_s * 1e3) +
+                 format("through a low-pass (second order, %.4g Hz, damping %.2g)",
+                        c.dynamics_frequency_hz, c.dynamics_damping) +
+                 tail;
+  } else {
+    f.evidence = "the recorded " + n +
+                 format(
+                     " rings and lags at fast changes like a resonance at %.4g Hz with %.2g "
+                     "damping (inertia of stack and load)",
+                     c.dynamics_frequency_hz, c.dynamics_damping) +
+                 tail;
+  }
   f.feature_name = "rate of the drive [1/s]";
   f.feature = rate_of(s.drive, s.sample_time);
 }

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <numbers>
 #include <span>
 #include <string>
 #include <vector>
@@ -19,6 +20,10 @@ namespace selfsense::diagnosis::detail {
 
 using identification::CorrectionTerm;
 using models::ChannelCorrection;
+
+// The damping from which a fitted mode has no resonant peak (1/sqrt(2)): in the band it is a
+// delay of 2 zeta / w0 to second order, and its finding is named `delay` (describe_dynamics).
+inline constexpr double kNoResonanceDamping = 1.0 / std::numbers::sqrt2;
 
 enum class Needs : std::uint8_t { kNothing, kTemperature, kStress, kSensed, kChargeDrive };
 

@@ -327,6 +327,12 @@ const Mechanism kMechanisms[] = {
     // the delay and is named (excess 0.13x, measured). Seed 2400008 is a draw of the proof run on
     // seed base 2400000 (docs/diagnose.md), traced after it.
     {"FastDampedModeIsNamedAsAModeNotADelay", Effect::kDynamics, 2400008},
+    // The converse: S sampled 0.45 samples late (cubic interpolation), with the base identified
+    // on the same recording. A second-order low-pass fits the lag best (422 Hz, damping 1.2 at
+    // 1054 Hz) and was named `dynamics`, although it has no resonant peak: in the band it is a
+    // delay (0.39 samples at DC), as an acquisition chain's filters are. Named `delay` on S where
+    // the fitted damping is 1/sqrt(2) or more (excess 0.10x either way, measured).
+    {"LowPassWithoutResonanceIsNamedADelay", Effect::kDelay, 900032},
     // Charge that leaks through a high-pass of tau 19 100 s, with the base identified on the
     // same recording: its slowest lags took the leak in over the half it was fitted on, so the
     // leak re-identified on that half fitted it only 11 % better (min_explains is 30 %) although
