@@ -46,7 +46,9 @@ struct Candidate {
   bool on_sensed;  // the reconstruction can invert it on the sensed channel
   bool on_strain;
   Needs needs;
-  Describe describe;  // fills the finding's evidence and its explaining feature
+  // Fills the finding's evidence and its explaining feature; may name the effect more closely
+  // than `effect` (a fitted mode without a resonant peak is a delay: describe_dynamics).
+  Describe describe;
   // The hysteresis operators bend to many residuals (a static curve, a slow drift under a
   // periodic drive): chosen only when no specific physics explains the residual significantly.
   bool generic{false};
