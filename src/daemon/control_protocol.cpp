@@ -65,6 +65,15 @@ std::string echo(std::string_view text) {
   return echo.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
+// A member's name as given where it is plain printable ASCII, else echoed as a JSON string (a
+// name with a line break or control character would break the one-line error).
+std::string member_name(std::string_view name) {
+  const bool plain = name.size() <= kMaxEcho && std::all_of(name.begin(), name.end(), [](char c) {
+                       return c >= ' ' && c <= '~';
+                     });
+  return plain ? std::string(name) : echo(name);
+}
+
 std::string joined(std::initializer_list<std::string_view> words) {
   std::string out;
   for (const std::string_view word : words) {
@@ -100,7 +109,7 @@ class Members final {
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
         const std::string takes = allowed.size() == 0 ? context + " takes no members"
                                                       : context + " takes: " + joined(allowed);
-        reject(path(key) + ": unknown member (" + takes + ")");
+        reject(kind_ + "." + member_name(key) + ": unknown member (" + takes + ")");
       }
     }
   }

@@ -192,6 +192,11 @@ TEST(ControlProtocol, PeriodicWaveErrors) {
   EXPECT_EQ(rejected(sine + R"("amplitude":1e-4,"frequency_hz":1,"freq":1})"),
             "wave.freq: unknown member (wave takes: shape, amplitude, offset, frequency_hz, phase, "
             "repeat, levels, dwell_s, values, dt_s)");
+  // A name with a control character is echoed escaped, so the error stays one line (found by
+  // the fuzzer: "\r" in a member's name).
+  EXPECT_EQ(rejected(sine + R"("amplitude":1e-4,"frequency_hz":1,"\requency":1})"),
+            "wave.\"\\requency\": unknown member (wave takes: shape, amplitude, offset, "
+            "frequency_hz, phase, repeat, levels, dwell_s, values, dt_s)");
 }
 
 TEST(ControlProtocol, EveryValueAWaveReachesIsInsideTheRange) {
