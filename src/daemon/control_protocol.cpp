@@ -109,7 +109,7 @@ class Members final {
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
         const std::string takes = allowed.size() == 0 ? context + " takes no members"
                                                       : context + " takes: " + joined(allowed);
-        reject(kind_ + "." + member_name(key) + ": unknown member (" + takes + ")");
+        reject(path(member_name(key)) + ": unknown member (" + takes + ")");
       }
     }
   }
