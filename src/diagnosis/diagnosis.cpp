@@ -237,17 +237,18 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
       if (loaded) search_again(*loaded, {});
     }
     // A channel sampled late bends the base the same way (its fastest lags follow the lag, so a
-    // delay fitted after it wins on fast blocks and loses on slow ones): where a lag explained
-    // min_explains of the held-out residual in the first round and the rounds named nothing
-    // but lags on the whole record, the delay (on S also a mode around the rounds' one) is
-    // judged by re-identification.
+    // delay fitted after it wins on fast blocks and loses on slow ones; a lag of several
+    // samples it takes in as loop width, and a delay after it then explains next to nothing):
+    // where nothing but lags is named on the channel, the delay (on S also a mode around the
+    // rounds' one) is judged by re-identification (more cheaply where the rounds saw no lag).
     const bool only_lags = std::all_of(found.begin(), found.end(), [](const Finding& f) {
       return f.effect == "delay" || f.effect == "dynamics";
     });
-    if (!reidentified && (st.rounds_named == 0 || only_lags) &&
-        st.lag_explains >= options.min_explains) {
+    if (!reidentified && (st.rounds_named == 0 || only_lags)) {
+      const LagSeen seen =
+          st.lag_explains >= options.min_explains ? LagSeen::kInRounds : LagSeen::kNo;
       std::optional<Reidentified> late =
-          reidentified_lag(model, s, ch, model_output, options, st.lag_mode);
+          reidentified_lag(model, s, ch, model_output, options, st.lag_mode, seen);
       if (late) search_again(*late, {});
     }
     result.findings.insert(result.findings.end(), std::make_move_iterator(found.begin()),

@@ -459,7 +459,8 @@ std::optional<Reidentified> reidentified_lag(const models::TransducerModel& mode
                                              const ChannelData& ch,
                                              const std::vector<double>& current,
                                              const Options& options,
-                                             const models::ChannelCorrection& mode_seed) {
+                                             const models::ChannelCorrection& mode_seed,
+                                             LagSeen seen) {
   if (!reidentifiable(model, s, ch)) return std::nullopt;
   const Judge judge(model, s, ch);
   const double most = static_cast<double>(models::kMaxCorrectionDelaySamples) * s.sample_time;
@@ -483,7 +484,28 @@ std::optional<Reidentified> reidentified_lag(const models::TransducerModel& mode
   };
   const Trial null = judge.trial(models::ChannelCorrection{});
   if (null.forecast.empty()) return std::nullopt;
-  Trial best = best_of(judge, grid, neighbours);
+  Trial best;
+  if (seen == LagSeen::kInRounds) {
+    best = best_of(judge, grid, neighbours);
+  } else {
+    double last = std::numeric_limits<double>::infinity();
+    int worse = 0;
+    for (const models::ChannelCorrection& effect : grid) {
+      Trial t = judge.trial(effect);
+      worse = t.first_half_sse > last ? worse + 1 : 0;
+      last = t.first_half_sse;
+      if (t.first_half_sse < best.first_half_sse) best = std::move(t);
+      if (worse == 2) break;
+    }
+    if (best.forecast.empty() ||
+        1.0 - best.first_half_sse / null.first_half_sse < options.min_explains) {
+      return std::nullopt;
+    }
+    for (const models::ChannelCorrection& effect : neighbours(best.effect)) {
+      Trial t = judge.trial(effect);
+      if (t.first_half_sse < best.first_half_sse) best = std::move(t);
+    }
+  }
   if (best.forecast.empty()) return std::nullopt;
   // A fast, damped mode on S lags like a delay in the excitation's band; its resonance bends
   // the response the other way above it ((4 zeta^2 - 1) / w0^2 against the delay's tau^2 / 2

@@ -154,10 +154,19 @@ struct StressReidentified {
 // mode_undone.hpp); the best replaces the delay where the delay's first-half residual is more
 // than `parsimony_ratio` times the mode's (the rounds' rule for the simpler of two candidates:
 // the mode has one parameter more), and the finding is then `dynamics`.
+//
+// Where the rounds saw no lag (LagSeen::kNo: no delay or mode explained min_explains in the
+// first round), the base may have taken a lag of several samples in as loop width, which the
+// first half's fit shows plainly once the lag is undone. There the delays are tried from the
+// shortest up until the fit has worsened twice in a row, and the lag is judged only where the
+// best fits the first half by min_explains better than the null (no backcast in its place, no
+// refinement or mode before that): a few identifications on a channel with no lag.
+enum class LagSeen { kInRounds, kNo };
+
 [[nodiscard]] std::optional<Reidentified> reidentified_lag(
     const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
     const std::vector<double>& current, const Options& options,
-    const models::ChannelCorrection& mode_seed = {});
+    const models::ChannelCorrection& mode_seed = {}, LagSeen seen = LagSeen::kInRounds);
 
 }  // namespace selfsense::diagnosis::detail
 
