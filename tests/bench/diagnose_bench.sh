@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Speed of `selfsense diagnose` on a 1e6-sample recording (issue 11: under 60 s on one core).
+# Speed of `selfsense diagnose` on a 1e6-sample recording (issue 23: under 30 s on one core).
 # Generates the diagnosis bench at 10 kHz (tests/diagnosis/data, 101.2 s: 1.012e6 samples),
 # identifies the base model on the effect-free recording, then times the diagnosis of the one
 # with charge leakage and creep on CPU 1. With `clean`, the diagnosed recording is another of the
-# effect-free plant (another excitation seed): nothing is named, so every channel takes the
-# judgements that run where nothing is (the lag's re-identification), the slowest case. Prints
-# the wall time; not part of the test run.
+# effect-free plant (another excitation seed): nothing is named, so every judgement by
+# re-identification that runs where nothing is named does (the leak's on D, the lag's on both
+# channels), the slowest case (docs/diagnose.md, "Speed"). Prints the wall time; not part of the
+# test run.
 #   tests/bench/diagnose_bench.sh build/src/cli/selfsense [clean]
 set -euo pipefail
 bin=${1:?usage: diagnose_bench.sh SELFSENSE_BINARY [clean]}

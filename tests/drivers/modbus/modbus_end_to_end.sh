@@ -105,9 +105,10 @@ fi
 start_device "$port"
 sleep 1.0
 [ "$(counter driver_reconnects)" -ge 1 ] || fail "no reconnect counted: $(ctl status)"
-# Re-armed as a user would: reset until ready, settle, arm (arm_run). Under the sanitizers the
-# restarted device can answer late once more, latching a fresh driver fault between the reset and
-# the arm; like a watched run, that is reported and tried once more, and a second fault fails.
+# Re-armed as a user would: reset until ready, settle, arm (arm_run). A back-to-back reset and
+# arm were once refused here under the sanitizers (one CI run; the reason was not printed then,
+# most likely a fresh fault from the restarted device latched between the two). Like a watched
+# run, a failed re-arm is now reported with its faults and tried once more; a second one fails.
 rearmed=
 for attempt in 1 2; do
   if arm_run position; then rearmed=yes; break; fi
