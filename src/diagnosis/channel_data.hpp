@@ -2,14 +2,37 @@
 // model's output, and what the candidates read besides.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "selfsense/models/side_model.hpp"
+#include "selfsense/models/transducer_model.hpp"
 
 namespace selfsense::diagnosis::detail {
+
+// The channel's side identified on the first half of the recording as recorded, per structure:
+// the null of every judgement by re-identification on the channel and the first half of the
+// stress's cross-fit (reidentified.hpp, first_half_fit). On a long record each identification
+// costs seconds, so it runs once (docs/diagnose.md, "Speed").
+class FirstHalfFits {
+ public:
+  [[nodiscard]] const models::TransducerModel* find(models::Structure structure) const {
+    for (const auto& [s, m] : fits_) {
+      if (s == structure) return &m;
+    }
+    return nullptr;
+  }
+  void keep(models::Structure structure, models::TransducerModel model) {
+    fits_.emplace_back(structure, std::move(model));
+  }
+
+ private:
+  std::vector<std::pair<models::Structure, models::TransducerModel>> fits_{};
+};
 
 struct ChannelData {
   std::string name;
@@ -19,6 +42,8 @@ struct ChannelData {
   double coupling{0.0};                    // of the stress in the model's side
   std::span<const double> sensed_model{};  // the model's sensed response (electrostriction)
   bool affine{true};  // not the stress-hysteresis model: the response is G[x] + y0
+  // Shared by the channel's copies (the recording they read is the same).
+  std::shared_ptr<FirstHalfFits> first_half{std::make_shared<FirstHalfFits>()};
 };
 
 // A channel's response to the drive alone, r = y - coupling T (y itself without a stress).

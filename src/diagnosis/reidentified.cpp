@@ -20,6 +20,7 @@ struct Trial {
   models::ChannelCorrection effect{};
   std::vector<double> forecast{};  // the identified model's channel through the effect
   double first_half_sse{std::numeric_limits<double>::infinity()};
+  std::vector<double> start{};  // the identified side's remanent state at the first sample
 };
 
 class Judge {
@@ -61,10 +62,11 @@ class Judge {
     return out;
   }
 
-  // The structure's side of this channel identified on `y` over its first `samples` samples.
-  [[nodiscard]] models::TransducerModel identify(const std::vector<double>& y,
-                                                 std::size_t samples) const {
-    return identify_over(y, 0, samples);
+  // The structure's side of this channel identified on `y` over its first `samples` samples,
+  // from `start` when given (OperatorStructure::start), else from the state it searches for.
+  [[nodiscard]] models::TransducerModel identify(const std::vector<double>& y, std::size_t samples,
+                                                 const std::vector<double>& start = {}) const {
+    return identify_over(y, 0, samples, start);
   }
 
   // The identified model's channel over the whole record, through the effect.
@@ -81,11 +83,20 @@ class Judge {
     return identification::apply_correction(cs, effect);
   }
 
-  [[nodiscard]] Trial trial(const models::ChannelCorrection& effect) const {
+  // The side identified on the first half with `effect` undone, from `start` when given. The
+  // trials of one family take their null's start (Trial::start): the drive left the stack in
+  // the same state whichever effect is undone, and on a long record the search for that state
+  // costs most of an identification (five sixths at 1e6 samples: docs/diagnose.md, "Speed").
+  [[nodiscard]] Trial trial(const models::ChannelCorrection& effect,
+                            const std::vector<double>& start = {}) const {
     Trial t;
     t.effect = effect;
     try {
-      t.forecast = forecast(identify(undone(effect), half_), effect);
+      const models::TransducerModel m = effect.empty() && start.empty()
+                                            ? first_half_fit(structure_, s_, ch_)
+                                            : identify(undone(effect), half_, start);
+      if (const std::optional<models::SideModel>& side = side_of(m)) t.start = side->history;
+      t.forecast = forecast(m, effect);
     } catch (const std::invalid_argument&) {
       return t;  // no identification with this effect undone: not a candidate
     }
@@ -119,7 +130,8 @@ class Judge {
   // The structure's side identified on `count` samples of `y` from `offset` (the model's state
   // starts at rest there, as at the start of any recording).
   [[nodiscard]] models::TransducerModel identify_over(const std::vector<double>& y,
-                                                      std::size_t offset, std::size_t count) const {
+                                                      std::size_t offset, std::size_t count,
+                                                      const std::vector<double>& start = {}) const {
     const auto part = [offset, count](std::span<const double> x) {
       return x.empty() ? x : x.subspan(offset, count);
     };
@@ -128,7 +140,9 @@ class Judge {
     (ch_.sensed ? t.sensed : t.strain) = part(y);
     t.stress = part(s_.stress);
     t.sample_time = s_.sample_time;
-    return identification::identify(t, structure_, identification::defaults_for(structure_));
+    identification::IdentificationOptions options = identification::defaults_for(structure_);
+    options.start = start;
+    return identification::identify(t, structure_, options);
   }
 
   const Signals& s_;
@@ -174,7 +188,21 @@ models::ChannelCorrection scaled(models::ChannelCorrection c, double factor) {
   return c;
 }
 
+// A leak's neighbours: at a factor sqrt(3) either way.
+std::vector<models::ChannelCorrection> leak_neighbours(const models::ChannelCorrection& c) {
+  return {scaled(c, std::sqrt(3.0)), scaled(c, 1.0 / std::sqrt(3.0))};
+}
+
 }  // namespace
+
+models::TransducerModel first_half_fit(models::Structure structure, const Signals& s,
+                                       const ChannelData& ch) {
+  if (const models::TransducerModel* kept = ch.first_half->find(structure)) return *kept;
+  const Judge judge(s, ch, structure);
+  models::TransducerModel m = judge.identify(judge.undone({}), judge.half());
+  ch.first_half->keep(structure, m);
+  return m;
+}
 
 const Candidate& candidate_using(CorrectionTerm term) {
   for (const Candidate& c : candidates()) {
@@ -277,18 +305,18 @@ std::optional<Reidentified> identified_whole(const Judge& judge,
 }
 
 // The effect of one family that fits the first half best: a coarse grid, then `refine`'s
-// neighbours of the best.
+// neighbours of the best, each trial from `start` (the null's).
 template <typename Refine>
 Trial best_of(const Judge& judge, const std::vector<models::ChannelCorrection>& grid,
-              Refine&& refine) {
+              Refine&& refine, const std::vector<double>& start) {
   Trial best;
   for (const models::ChannelCorrection& effect : grid) {
-    Trial t = judge.trial(effect);
+    Trial t = judge.trial(effect, start);
     if (t.first_half_sse < best.first_half_sse) best = std::move(t);
   }
   if (best.forecast.empty()) return best;
   for (const models::ChannelCorrection& effect : refine(best.effect)) {
-    Trial t = judge.trial(effect);
+    Trial t = judge.trial(effect, start);
     if (t.first_half_sse < best.first_half_sse) best = std::move(t);
   }
   return best;
@@ -348,7 +376,7 @@ std::optional<Reidentified> judged_as_forecast(const Judge& judge, const Channel
                                                ShownBy evidence = ShownBy::kFitAndForecast) {
   const Trial null = judge.trial(models::ChannelCorrection{});
   if (null.forecast.empty()) return std::nullopt;
-  const Trial best = best_of(judge, grid, std::forward<Refine>(refine));
+  const Trial best = best_of(judge, grid, std::forward<Refine>(refine), null.start);
   if (best.forecast.empty()) return std::nullopt;
   return judged(judge, ch, null, best, options, evidence);
 }
@@ -387,19 +415,9 @@ std::string lags_of(const models::SideModel& side) {
 constexpr models::Structure kWithCreep = models::Structure::kHysteresisCreep;
 
 // The leak of the grid (coarse_leaks, then the best one's neighbours at a factor sqrt(3)) that
-// fits the first half best with this judge's structure.
-Trial best_leak(const Judge& judge, const Signals& s) {
-  Trial best;
-  for (const models::ChannelCorrection& effect : coarse_leaks(s)) {
-    Trial t = judge.trial(effect);
-    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
-  }
-  if (best.forecast.empty()) return best;
-  for (const double factor : {std::sqrt(3.0), 1.0 / std::sqrt(3.0)}) {
-    Trial t = judge.trial(scaled(best.effect, factor));
-    if (t.first_half_sse < best.first_half_sse) best = std::move(t);
-  }
-  return best;
+// fits the first half best with this judge's structure, each trial from `start`.
+Trial best_leak(const Judge& judge, const Signals& s, const std::vector<double>& start) {
+  return best_of(judge, coarse_leaks(s), leak_neighbours, start);
 }
 
 // The leak's candidate, terms and finding on a re-identified side that carries it.
@@ -445,12 +463,8 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
                                               const Options& options, ShownBy evidence) {
   if (!ch.sensed || !reidentifiable(model, s, ch)) return std::nullopt;
   const Judge judge(model, s, ch);
-  const auto neighbours = [](const models::ChannelCorrection& c) {
-    return std::vector<models::ChannelCorrection>{scaled(c, std::sqrt(3.0)),
-                                                  scaled(c, 1.0 / std::sqrt(3.0))};
-  };
   std::optional<Reidentified> r =
-      judged_as_forecast(judge, ch, coarse_leaks(s), neighbours, options, evidence);
+      judged_as_forecast(judge, ch, coarse_leaks(s), leak_neighbours, options, evidence);
   if (r) as_leak(*r, ch, s, current, as_forecast(judge, s, ch, "leak"));
   return r;
 }
@@ -486,12 +500,12 @@ std::optional<Reidentified> reidentified_lag(const models::TransducerModel& mode
   if (null.forecast.empty()) return std::nullopt;
   Trial best;
   if (seen == LagSeen::kInRounds) {
-    best = best_of(judge, grid, neighbours);
+    best = best_of(judge, grid, neighbours, null.start);
   } else {
     double last = std::numeric_limits<double>::infinity();
     int worse = 0;
     for (const models::ChannelCorrection& effect : grid) {
-      Trial t = judge.trial(effect);
+      Trial t = judge.trial(effect, null.start);
       worse = t.first_half_sse > last ? worse + 1 : 0;
       last = t.first_half_sse;
       if (t.first_half_sse < best.first_half_sse) best = std::move(t);
@@ -502,7 +516,7 @@ std::optional<Reidentified> reidentified_lag(const models::TransducerModel& mode
       return std::nullopt;
     }
     for (const models::ChannelCorrection& effect : neighbours(best.effect)) {
-      Trial t = judge.trial(effect);
+      Trial t = judge.trial(effect, null.start);
       if (t.first_half_sse < best.first_half_sse) best = std::move(t);
     }
   }
@@ -535,7 +549,7 @@ std::optional<Reidentified> reidentified_lag(const models::TransducerModel& mode
         out.push_back(with_mode(c.dynamics_frequency_hz, z * c.dynamics_damping));
       return out;
     };
-    Trial best_mode = best_of(judge, modes, mode_neighbours);
+    Trial best_mode = best_of(judge, modes, mode_neighbours, null.start);
     if (!best_mode.forecast.empty() &&
         best.first_half_sse > options.parsimony_ratio * best_mode.first_half_sse) {
       best = std::move(best_mode);
@@ -587,14 +601,14 @@ std::optional<CreepAndLeak> reidentified_creep_and_leak(const models::Transducer
   const Judge as_is(model, s, ch);
   const Judge with_creep(s, ch, kWithCreep);
   const Trial null = as_is.trial(models::ChannelCorrection{});
-  const Trial pair = best_leak(with_creep, s);
+  const Trial creep = with_creep.trial(models::ChannelCorrection{});
+  const Trial pair = best_leak(with_creep, s, creep.start);
   const std::optional<double> explains =
       held_out_explains(as_is, null, with_creep, pair, ch, options, ShownBy::kFitAndForecast);
   if (!explains) return std::nullopt;
   // Each part must carry the forecast: the pair beats the creep structure alone and the model's
   // structure with its own best leak.
-  const Trial creep = with_creep.trial(models::ChannelCorrection{});
-  const Trial leak = best_leak(as_is, s);
+  const Trial leak = best_leak(as_is, s, null.start);
   if (!forecast_explains(creep, pair, ch, as_is.half(), options, ShownBy::kForecast) ||
       !forecast_explains(leak, pair, ch, as_is.half(), options, ShownBy::kForecast)) {
     return std::nullopt;

@@ -141,6 +141,12 @@ struct StressReidentified {
     const models::TransducerModel& model, const Signals& s,
     const std::vector<ChannelData>& channels, const Options& options);
 
+// The structure's side of the channel identified on the first half of the recording as recorded
+// (the model's state at the start searched for): identified once per structure and channel
+// (ChannelData::first_half). Throws std::invalid_argument where no identification exists.
+[[nodiscard]] models::TransducerModel first_half_fit(models::Structure structure, const Signals& s,
+                                                     const ChannelData& ch);
+
 // The first candidate that carries `term`.
 [[nodiscard]] const Candidate& candidate_using(identification::CorrectionTerm term);
 

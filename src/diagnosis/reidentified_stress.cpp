@@ -59,6 +59,35 @@ CrossFit cross_fit(const Signals& s, Structure structure) {
   return c;
 }
 
+// The same for the model's own structure, whose sides are identified apart: the first half's
+// are the channels' nulls (first_half_fit), identified once for every judgement, where the
+// channels are every side the recording has.
+CrossFit cross_fit(const Signals& s, Structure structure,
+                   const std::vector<ChannelData>& channels) {
+  const std::size_t n = s.drive.size();
+  const auto has = [&](bool sensed) {
+    return std::any_of(channels.begin(), channels.end(),
+                       [sensed](const ChannelData& ch) { return ch.sensed == sensed; });
+  };
+  if (channels.empty() || (!s.sensed.empty() && !has(true)) || (!s.strain.empty() && !has(false))) {
+    return cross_fit(s, structure);
+  }
+  models::TransducerModel first = first_half_fit(structure, s, channels.front());
+  for (std::size_t i = 1; i < channels.size(); ++i) {
+    models::TransducerModel m = first_half_fit(structure, s, channels[i]);
+    if (channels[i].sensed) {
+      first.sensor = std::move(m.sensor);
+      first.sensed_range = m.sensed_range;
+    } else {
+      first.actuator = std::move(m.actuator);
+    }
+  }
+  CrossFit c;
+  c.first = simulate(first, s);
+  c.second = simulate(identified(s, structure, n / 2, n), s);
+  return c;
+}
+
 // The channel as each half's unseen model forecasts it, and the fit of each model on its own
 // half (the identification's own error).
 struct Judged {
@@ -149,7 +178,7 @@ std::optional<StressReidentified> reidentified_stress(const models::TransducerMo
   CrossFit null;
   CrossFit stressed;
   try {
-    null = cross_fit(s, model.structure);
+    null = cross_fit(s, model.structure, channels);
     stressed = cross_fit(s, Structure::kStressHysteresis);
   } catch (const std::invalid_argument&) {
     return std::nullopt;
@@ -172,8 +201,9 @@ std::optional<StressReidentified> reidentified_stress(const models::TransducerMo
     if (!(null_sse > 0.0) || !(a.own_sse > 0.0)) return std::nullopt;
     // The structure replaces both sides: no channel may forecast worse with it.
     if (stress_sse > null_sse) return std::nullopt;
-    // As forecast_explains: the identification's own evidence (each half fitted by
-    // min_explains better), then the unseen halves by the rules of a round.
+    // As forecast_explains: the identification's own evidence (both halves, each by the model
+    // identified on it, fitted by min_explains better together), then the unseen halves by the
+    // rules of a round.
     const double explains = 1.0 - stress_sse / null_sse;
     if (1.0 - b.own_sse / a.own_sse < options.min_explains || explains < options.min_explains ||
         !passes_blocks(block_explains(ch.recorded, a.unseen, b.unseen, rows), options)) {

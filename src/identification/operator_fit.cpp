@@ -487,8 +487,9 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
   const OperatorBasis basis = basis_for(signals, structure, x_range);
   Fitter fitter(signals, basis, weight_floor, structure.fit_offset);
 
-  const bool search = structure.estimate_history && structure.plays > 0;
+  const bool search = structure.estimate_history && structure.plays > 0 && structure.start.empty();
   std::vector<double> history{signals.input.front()};
+  if (!structure.start.empty()) history = structure.start;
   if (search) {
     history = best_start(fitter, signals.input,
                          start_finalists(signals, basis, weight_floor, structure.fit_offset, {}));

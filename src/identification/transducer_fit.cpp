@@ -29,6 +29,7 @@ OperatorStructure structure_of(const IdentificationOptions& o, bool creep) {
   s.fastest_eigenvalue = o.fastest_eigenvalue;
   s.slowest_eigenvalue = o.slowest_eigenvalue;
   s.bias_levels = o.bias_levels;
+  s.start = o.start;
   return s;
 }
 

@@ -20,12 +20,12 @@
 //     alternate between S, g, offset (linear in them for a fixed H + K) and a Gauss-Newton
 //     step for H + K, g, offset (exact on each linear piece of S), each a bounded least-squares
 //     problem again; the fit with the smallest output error is kept;
-//  3. the remanent state before the first sample is chosen among candidate input histories
-//     (remanent_state.hpp: a last turning point on a grid inside and beyond the recorded
-//     range, and the demagnetised start): cheap proxies of the basis rank those inside the
-//     range, then the whole basis decides between their picks and the rest over the whole
-//     recording and refines the winner's turning point; with dead zones a second time through
-//     the fitted S^-1 (docs/identification.md).
+//  3. unless given (OperatorStructure::start), the remanent state before the first sample is
+//     chosen among candidate input histories (remanent_state.hpp: a last turning point on a
+//     grid inside and beyond the recorded range, and the demagnetised start): cheap proxies of
+//     the basis rank those inside the range, then the whole basis decides between their picks
+//     and the rest over the whole recording and refines the winner's turning point; with dead
+//     zones a second time through the fitted S^-1 (docs/identification.md).
 // Thresholds follow from the input's range, creep eigenvalues from the sample time and the
 // duration. Not real-time code.
 #pragma once
@@ -50,6 +50,11 @@ struct OperatorStructure {
   double fastest_eigenvalue{0.0};  // [1/s]; 0: min(100, 0.1 / Ts)
   double slowest_eigenvalue{0.0};  // [1/s]; 0: 3 / duration
   bool estimate_history{true};     // false: start demagnetised at the first input
+  // The remanent state at the first sample when it is known (a history of input turning
+  // points ending at the first input, SideModel::history): no search. A fit of the same input
+  // with another output (an effect undone) starts where the drive left the stack either way,
+  // and on a long record the search costs most of the fit (docs/identification.md).
+  std::vector<double> start{};
   bool fit_offset{true};
   std::size_t refinement_passes{2};  // output-error passes after the equation error (dead zones)
 };

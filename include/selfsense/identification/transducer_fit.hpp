@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <functional>
 #include <span>
+#include <vector>
 
 #include "selfsense/models/transducer_model.hpp"
 
@@ -37,6 +38,9 @@ struct IdentificationOptions {
   // kStressPlayCandidates on the fitting data alone: the reconstruction error (T_hat, and S_hat
   // with a strain channel) on the last quarter of a fit on the first three quarters.
   bool choose_plays{false};
+  // The fitted side's remanent state at the first sample, when known (OperatorStructure::start;
+  // not for stress-hysteresis): the diagnosis's trials of one recording take their null's.
+  std::vector<double> start{};
 };
 inline constexpr std::array<std::size_t, 4> kBiasLevelCandidates{0, 1, 3, 7};
 inline constexpr std::array<std::size_t, 3> kStressPlayCandidates{16, 24, 48};
