@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "selfsense/adaptation/adapted_reconstruction.hpp"
 #include "selfsense/models/reconstructor.hpp"
@@ -90,47 +92,44 @@ models::SideTemperature side_of(const std::array<double, kMax>& x, bool quadrati
   return {{x[0], x[1]}, {x[2], x[3]}, {x[4], x[5]}};
 }
 
-}  // namespace
+// How many of the intervals [lo + i w, lo + (i + 1) w) the temperature visits (at most
+// kManyLevels counted).
+std::size_t temperature_levels(const std::vector<TemperatureFitInput>& recordings, double lo,
+                               double w) {
+  constexpr std::size_t kManyLevels = 1000;
+  std::vector<bool> seen(kManyLevels, false);
+  std::size_t levels = 0;
+  for (const TemperatureFitInput& in : recordings) {
+    for (const double temp : in.temperature) {
+      if (!std::isfinite(temp)) continue;
+      const double i = std::floor((temp - lo) / w);
+      if (!(i >= 0.0) || i >= static_cast<double>(kManyLevels)) return kManyLevels;
+      const auto index = static_cast<std::size_t>(i);
+      if (!seen[index]) {
+        seen[index] = true;
+        ++levels;
+      }
+    }
+  }
+  return levels;
+}
 
-TemperatureFitResult fit_temperature(const models::TransducerModel& model,
-                                     const TemperatureFitInput& in, double reference_degc,
-                                     bool quadratic, double min_span_k,
-                                     double min_field_step_v_per_m, double max_interval_s) {
-  if (model.drive() != models::Drive::kField || model.vectorial || !model.sensor ||
-      !model.actuator) {
-    throw std::invalid_argument{
-        "temperature fit: needs a field-driven model with a sensor and an actuator side"};
-  }
-  if (model.sensed_correction || model.strain_correction) {
-    throw std::invalid_argument{
-        "temperature fit: a model with diagnosed corrections is not fitted"};
-  }
-  const std::size_t n = in.field.size();
-  if (in.sensed.size() != n || in.stress.size() != n || in.strain.size() != n ||
-      in.temperature.size() != n) {
-    throw std::invalid_argument{"temperature fit: the columns differ in length"};
-  }
-  if (n < 100) throw std::invalid_argument{"temperature fit: fewer than 100 samples"};
-  if (!std::isfinite(reference_degc)) {
-    throw std::invalid_argument{"temperature fit: the reference temperature must be finite"};
-  }
-  const auto [lo, hi] = std::minmax_element(in.temperature.begin(), in.temperature.end());
-  if (!(*hi - *lo >= min_span_k)) {
-    throw std::invalid_argument{"temperature fit: the temperature spans " +
-                                std::to_string(*hi - *lo) + " K, less than " +
-                                std::to_string(min_span_k) + " K"};
-  }
+// The rows of every recording, per side and for the increments.
+struct Normals {
+  SideNormal sensor;
+  SideNormal actuator;
+  SideNormal increments{4};
+};
 
+// Adds one recording's rows: the model run along it from its start state.
+void add_recording(const models::TransducerModel& model, const TemperatureFitInput& in,
+                   double reference_degc, bool quadratic, double min_field_step_v_per_m,
+                   double max_interval_s, Normals& normals, TemperatureFitResult& out) {
   models::Reconstructor kernel(model);
   models::SideOperator& s = *kernel.sensor();
   models::SideOperator& a = *kernel.actuator();
   const SideSplit sensor_split(s);
   const SideSplit actuator_split(a);
-  const std::size_t cols = quadratic ? 6 : 3;
-  SideNormal sensor(cols);
-  SideNormal actuator(cols);
-  SideNormal increments(4);
-  TemperatureFitResult out;
   // The estimator's gate (drift_estimator.hpp): the anchor's E, D, L_s, H_s, T and age.
   struct Anchor {
     double e, d, l, h, t, age;
@@ -138,7 +137,7 @@ TemperatureFitResult fit_temperature(const models::TransducerModel& model,
   Anchor anchor{};
   bool anchored = false;
   const double sample_time = model.sample_time;
-  for (std::size_t k = 0; k < n; ++k) {
+  for (std::size_t k = 0; k < in.field.size(); ++k) {
     const double e = in.field[k];
     const double fixed_s = s.offset() + s.quadratic() * e * e;
     const double fixed_a = a.offset() + a.quadratic() * e * e;
@@ -158,8 +157,8 @@ TemperatureFitResult fit_temperature(const models::TransducerModel& model,
       anchored = false;
       continue;
     }
-    sensor.add(xs, ys);
-    actuator.add(xa, ya);
+    normals.sensor.add(xs, ys);
+    normals.actuator.add(xa, ya);
     ++out.samples;
     const double d = in.sensed[k] - fixed_s;
     if (!anchored || anchor.age > max_interval_s) {
@@ -172,22 +171,86 @@ TemperatureFitResult fit_temperature(const models::TransducerModel& model,
     const double dl = ps.linear - anchor.l;
     const double dh = ps.loop - anchor.h;
     const double dstress = s.coupling() * (t - anchor.t);
-    increments.add({dl * dt, dh * dt, dstress, dstress * dt, 0.0, 0.0},
-                   d - anchor.d - dl - dh - dstress);
+    normals.increments.add({dl * dt, dh * dt, dstress, dstress * dt, 0.0, 0.0},
+                           d - anchor.d - dl - dh - dstress);
     anchor = {e, d, ps.linear, ps.loop, t, 0.0};
     ++out.increments;
   }
-  const std::array<double, kMax> ts = sensor.solve();
-  const std::array<double, kMax> ta = actuator.solve();
+}
+
+}  // namespace
+
+TemperatureFitResult fit_temperature(const models::TransducerModel& model,
+                                     const TemperatureFitInput& in, double reference_degc,
+                                     bool quadratic, double min_span_k,
+                                     double min_field_step_v_per_m, double max_interval_s) {
+  return fit_temperature(model, std::vector<TemperatureFitInput>{in}, reference_degc, quadratic,
+                         min_span_k, min_field_step_v_per_m, max_interval_s);
+}
+
+TemperatureFitResult fit_temperature(const models::TransducerModel& model,
+                                     const std::vector<TemperatureFitInput>& recordings,
+                                     double reference_degc, bool quadratic, double min_span_k,
+                                     double min_field_step_v_per_m, double max_interval_s) {
+  if (model.drive() != models::Drive::kField || model.vectorial || !model.sensor ||
+      !model.actuator) {
+    throw std::invalid_argument{
+        "temperature fit: needs a field-driven model with a sensor and an actuator side"};
+  }
+  if (model.sensed_correction || model.strain_correction) {
+    throw std::invalid_argument{
+        "temperature fit: a model with diagnosed corrections is not fitted"};
+  }
+  if (!std::isfinite(reference_degc)) {
+    throw std::invalid_argument{"temperature fit: the reference temperature must be finite"};
+  }
+  // Per recording in the messages only where there are several.
+  const auto which = [&recordings](std::size_t i) {
+    return recordings.size() > 1 ? "recording " + std::to_string(i) + ": " : std::string{};
+  };
+  std::size_t total = 0;
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < recordings.size(); ++i) {
+    const TemperatureFitInput& in = recordings[i];
+    const std::size_t n = in.field.size();
+    if (in.sensed.size() != n || in.stress.size() != n || in.strain.size() != n ||
+        in.temperature.size() != n) {
+      throw std::invalid_argument{"temperature fit: " + which(i) + "the columns differ in length"};
+    }
+    total += n;
+    if (n == 0) continue;
+    const auto [l, h] = std::minmax_element(in.temperature.begin(), in.temperature.end());
+    lo = std::min(lo, *l);
+    hi = std::max(hi, *h);
+  }
+  if (total < 100) throw std::invalid_argument{"temperature fit: fewer than 100 samples"};
+  if (!(hi - lo >= min_span_k)) {
+    throw std::invalid_argument{"temperature fit: the temperature spans " +
+                                std::to_string(hi - lo) + " K, less than " +
+                                std::to_string(min_span_k) + " K"};
+  }
+
+  TemperatureFitResult out;
+  out.quadratic = quadratic && temperature_levels(recordings, lo, min_span_k) >= 3;
+  quadratic = out.quadratic;
+  const std::size_t cols = quadratic ? 6 : 3;
+  Normals normals{SideNormal(cols), SideNormal(cols)};
+  for (const TemperatureFitInput& in : recordings) {
+    add_recording(model, in, reference_degc, quadratic, min_field_step_v_per_m, max_interval_s,
+                  normals, out);
+  }
+  const std::array<double, kMax> ts = normals.sensor.solve();
+  const std::array<double, kMax> ta = normals.actuator.solve();
   out.coefficients.reference_degc = reference_degc;
   out.coefficients.sensor = side_of(ts, quadratic);
   out.coefficients.actuator = side_of(ta, quadratic);
-  out.sensor_rms_before = sensor.rms({});
-  out.sensor_rms_after = sensor.rms(ts);
-  out.actuator_rms_before = actuator.rms({});
-  out.actuator_rms_after = actuator.rms(ta);
+  out.sensor_rms_before = normals.sensor.rms({});
+  out.sensor_rms_after = normals.sensor.rms(ts);
+  out.actuator_rms_before = normals.actuator.rms({});
+  out.actuator_rms_after = normals.actuator.rms(ta);
   if (out.increments >= 100) {
-    const std::array<double, kMax> ti = increments.solve();
+    const std::array<double, kMax> ti = normals.increments.solve();
     out.coefficients.increments = {ti[0], ti[1]};
   }
   return out;

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -54,9 +55,10 @@ struct IdentifyOptions {
   int bias_levels{-1};
   double fastest{0.0};
   double slowest{0.0};
-  // Temperature coefficients (docs/adaptation.md): fitted on this recording (a ramp with a temp
-  // column), or on --recording itself when its temp column spans at least 2 K.
-  std::filesystem::path temperature_recording{};
+  // Temperature coefficients (docs/adaptation.md): fitted on these recordings together (a ramp
+  // with a temp column, or recordings at several temperatures), or on --recording itself when
+  // its temp column spans at least 2 K.
+  std::vector<std::filesystem::path> temperature_recordings{};
   std::string temperature_column{"temp"};
   double reference_degc{25.0};  // used when --recording has no temperature column
 };
@@ -93,10 +95,11 @@ void print_chosen_sizes(const models::TransducerModel& model, const char* how) {
   describe("actuator", model.actuator);
 }
 
-// The temperature coefficients (adaptation/temperature_fit.hpp) on the recording that has the
-// temperature: --temperature-recording, or the identification recording when its temperature
-// column spans at least 2 K; the reference is the identification recording's mean temperature
-// (or --reference-degc without one). Returns the JSON figures, or null when nothing was fitted.
+// The temperature coefficients (adaptation/temperature_fit.hpp) on the recordings that have the
+// temperature: --temperature-recording (one or several, fitted together), or the identification
+// recording when its temperature column spans at least 2 K; the reference is the identification
+// recording's mean temperature (or --reference-degc without one). Returns the JSON figures, or
+// null when nothing was fitted.
 nlohmann::json fit_temperature_coefficients(models::TransducerModel& model,
                                             const IdentifyOptions& opt, const io::Recording& rec,
                                             const FieldSignals& signals,
@@ -113,21 +116,20 @@ nlohmann::json fit_temperature_coefficients(models::TransducerModel& model,
       sum += v;
     reference = sum / static_cast<double>(own.size());
   }
-  std::optional<io::Recording> other;
-  if (!opt.temperature_recording.empty()) {
-    other = io::read_recording_csv(opt.temperature_recording, io::ReadOptions{{"t"}});
-  }
-  const io::Recording& source = other ? *other : rec;
-  const std::span<const double> temp = other ? column(*other) : own;
-  if (temp.empty()) {
-    if (other) {
-      throw std::invalid_argument("--temperature-recording: " + opt.temperature_recording.string() +
-                                  " has no column '" + opt.temperature_column + "'");
+  const bool other = !opt.temperature_recordings.empty();
+  std::vector<io::Recording> others;
+  for (const std::filesystem::path& path : opt.temperature_recordings) {
+    others.push_back(io::read_recording_csv(path, io::ReadOptions{{"t"}}));
+    if (column(others.back()).empty()) {
+      throw std::invalid_argument("--temperature-recording: " + path.string() + " has no column '" +
+                                  opt.temperature_column + "'");
     }
-    return nullptr;
   }
-  const auto [lo, hi] = std::minmax_element(temp.begin(), temp.end());
-  if (!other && *hi - *lo < 2.0) return nullptr;  // one temperature: nothing to fit
+  if (own.empty() && !other) return nullptr;
+  if (!other) {
+    const auto [lo, hi] = std::minmax_element(own.begin(), own.end());
+    if (*hi - *lo < 2.0) return nullptr;  // one temperature: nothing to fit
+  }
   if (!model.sensor || !model.actuator || model.drive() != models::Drive::kField ||
       model.vectorial) {
     if (other) {
@@ -138,32 +140,59 @@ nlohmann::json fit_temperature_coefficients(models::TransducerModel& model,
     std::printf("note: temperature column ignored: this structure has no coefficients per K\n");
     return nullptr;
   }
-  const std::string name = other ? opt.temperature_recording.string() : opt.recording.string();
-  const FieldSignals fs =
-      other ? field_signals(source, name, geometry, models::Drive::kField) : signals;
-  if (fs.stress.empty() || fs.s.empty() || fs.e.empty() || fs.d.empty()) {
-    throw std::invalid_argument("temperature coefficients: " + name + " needs E, D, S and T");
+  // Each recording's signals (kept alive here: the fit's inputs are views of them).
+  std::vector<std::string> names;
+  std::vector<FieldSignals> signals_of;
+  std::vector<std::span<const double>> temps;
+  if (!other) {
+    names.push_back(opt.recording.string());
+    signals_of.push_back(signals);
+    temps.push_back(own);
   }
+  for (std::size_t i = 0; i < others.size(); ++i) {
+    names.push_back(opt.temperature_recordings[i].string());
+    signals_of.push_back(field_signals(others[i], names.back(), geometry, models::Drive::kField));
+    temps.push_back(column(others[i]));
+  }
+  std::vector<adaptation::TemperatureFitInput> inputs;
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const FieldSignals& fs = signals_of[i];
+    if (fs.stress.empty() || fs.s.empty() || fs.e.empty() || fs.d.empty()) {
+      throw std::invalid_argument("temperature coefficients: " + names[i] + " needs E, D, S and T");
+    }
+    inputs.push_back({fs.e, fs.d, fs.stress, fs.s, temps[i]});
+    const auto [l, h] = std::minmax_element(temps[i].begin(), temps[i].end());
+    lo = std::min(lo, *l);
+    hi = std::max(hi, *h);
+  }
+  std::string name = names.front();
+  for (std::size_t i = 1; i < names.size(); ++i)
+    name += ", " + names[i];
   const adaptation::TemperatureFitResult fit =
-      adaptation::fit_temperature(model, {fs.e, fs.d, fs.stress, fs.s, temp}, reference);
+      adaptation::fit_temperature(model, inputs, reference);
   model.temperature = fit.coefficients;
   const models::SideTemperature& se = fit.coefficients.sensor;
   const models::SideTemperature& ac = fit.coefficients.actuator;
   std::printf(
       "temperature coefficients from %s (%.1f .. %.1f degC, reference %.2f degC), per K and "
-      "per K^2:\n"
+      "per K^2%s:\n"
       "  sensor   permittivity %+.3e %+.3e, loop %+.3e %+.3e, coupling   %+.3e %+.3e\n"
       "  actuator linear       %+.3e %+.3e, loop %+.3e %+.3e, compliance %+.3e %+.3e\n"
       "  residual RMS: D %.3g -> %.3g C/m^2, S %.3g -> %.3g\n"
       "  on the estimator's increments (%zu): permittivity %+.3e, loop %+.3e per K\n",
-      name.c_str(), *lo, *hi, reference, se.linear.per_k, se.linear.per_k2, se.loop.per_k,
-      se.loop.per_k2, se.coupling.per_k, se.coupling.per_k2, ac.linear.per_k, ac.linear.per_k2,
-      ac.loop.per_k, ac.loop.per_k2, ac.coupling.per_k, ac.coupling.per_k2, fit.sensor_rms_before,
-      fit.sensor_rms_after, fit.actuator_rms_before, fit.actuator_rms_after, fit.increments,
+      name.c_str(), lo, hi, reference,
+      fit.quadratic ? "" : " (first order: the temperature at fewer than three levels 2 K apart)",
+      se.linear.per_k, se.linear.per_k2, se.loop.per_k, se.loop.per_k2, se.coupling.per_k,
+      se.coupling.per_k2, ac.linear.per_k, ac.linear.per_k2, ac.loop.per_k, ac.loop.per_k2,
+      ac.coupling.per_k, ac.coupling.per_k2, fit.sensor_rms_before, fit.sensor_rms_after,
+      fit.actuator_rms_before, fit.actuator_rms_after, fit.increments,
       fit.coefficients.increments.linear_per_k, fit.coefficients.increments.loop_per_k);
   return {{"recording", name},
           {"reference_degc", reference},
           {"samples", fit.samples},
+          {"quadratic", fit.quadratic},
           {"sensed_rms_before", fit.sensor_rms_before},
           {"sensed_rms_after", fit.sensor_rms_after},
           {"strain_rms_before", fit.actuator_rms_before},
@@ -342,9 +371,10 @@ void add_identify_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--slowest-eigenvalue", opt->slowest, "Slowest creep eigenvalue [1/s]")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--temperature-recording", opt->temperature_recording,
-                  "A recording with a temperature column (a ramp) to fit the temperature "
-                  "coefficients on (default: --recording, when its temperature varies by 2 K)")
+  cmd->add_option("--temperature-recording", opt->temperature_recordings,
+                  "Recordings with a temperature column (a ramp, or recordings at several "
+                  "temperatures; repeat or list them) to fit the temperature coefficients on "
+                  "together (default: --recording, when its temperature varies by 2 K)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--temperature-column", opt->temperature_column,
                   "The temperature column [degC] (default temp)");

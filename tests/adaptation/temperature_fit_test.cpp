@@ -35,7 +35,8 @@ models::TemperatureCoefficients truth() {
   return c;
 }
 
-Ramp ramp(std::size_t n) {
+// From `from` to `to` degC over the n samples (one temperature where they are equal).
+Ramp ramp(std::size_t n, double from = 25.0, double to = 55.0) {
   Ramp out{test::typical_transducer(kTs), {}, {}, {}, {}, {}};
   const models::TemperatureCoefficients c = truth();
   models::SideOperator sensor(*out.model.sensor);
@@ -49,7 +50,7 @@ Ramp ramp(std::size_t n) {
     const double e = 1e6 * (1.0 + 0.9 * std::sin(2 * std::numbers::pi * 3.0 * time) *
                                       std::cos(2 * std::numbers::pi * 0.23 * time));
     const double t = -1e7 * (1.0 + 0.5 * std::sin(2 * std::numbers::pi * 0.7 * time + 0.5));
-    const double temp = 25.0 + 30.0 * static_cast<double>(k) / static_cast<double>(n);
+    const double temp = from + (to - from) * static_cast<double>(k) / static_cast<double>(n);
     const double dt = temp - c.reference_degc;
     const SideSplit::Parts ps =
         split_s.split(sensor, e, sensor.step_unloaded(e) - out.model.sensor->offset);
@@ -85,6 +86,7 @@ TEST(TemperatureFit, RecoversKnownCoefficients) {
   const TemperatureFitResult fit = fit_temperature(r.model, {r.e, r.d, r.t, r.s, r.temp}, 25.0);
   const models::TemperatureCoefficients want = truth();
   EXPECT_EQ(fit.samples, r.e.size());
+  EXPECT_TRUE(fit.quadratic);
   EXPECT_EQ(fit.coefficients.reference_degc, 25.0);
   expect_polynomial(fit.coefficients.sensor.linear, want.sensor.linear);
   expect_polynomial(fit.coefficients.sensor.loop, want.sensor.loop);
@@ -105,6 +107,47 @@ TEST(TemperatureFit, RecoversKnownCoefficients) {
       fit_temperature(r.model, {r.e, r.d, r.t, r.s, r.temp}, 25.0, false);
   EXPECT_EQ(linear.coefficients.sensor.linear.per_k2, 0.0);
   EXPECT_GT(linear.sensor_rms_after, fit.sensor_rms_after);
+}
+
+// Recordings each held at one temperature fit together what the ramp over their range fits; each
+// alone spans no temperature and is refused.
+TEST(TemperatureFit, RecordingsAtSeveralFixedTemperaturesFitTogether) {
+  const Ramp at25 = ramp(20000, 25.0, 25.0);
+  const Ramp at40 = ramp(20000, 40.0, 40.0);
+  const Ramp at55 = ramp(20000, 55.0, 55.0);
+  std::vector<TemperatureFitInput> recordings;
+  for (const Ramp* r : {&at25, &at40, &at55})
+    recordings.push_back({r->e, r->d, r->t, r->s, r->temp});
+  const TemperatureFitResult fit = fit_temperature(at25.model, recordings, 25.0);
+  const models::TemperatureCoefficients want = truth();
+  EXPECT_EQ(fit.samples, 60000U);
+  EXPECT_TRUE(fit.quadratic);  // three temperatures
+  expect_polynomial(fit.coefficients.sensor.linear, want.sensor.linear);
+  expect_polynomial(fit.coefficients.sensor.loop, want.sensor.loop);
+  expect_polynomial(fit.coefficients.sensor.coupling, want.sensor.coupling);
+  expect_polynomial(fit.coefficients.actuator.linear, want.actuator.linear);
+  expect_polynomial(fit.coefficients.actuator.loop, want.actuator.loop);
+  expect_polynomial(fit.coefficients.actuator.coupling, want.actuator.coupling);
+  EXPECT_LT(fit.sensor_rms_after, 1e-6 * fit.sensor_rms_before);
+  for (const TemperatureFitInput& one : recordings) {
+    EXPECT_THROW(static_cast<void>(fit_temperature(at25.model, one, 25.0)), std::invalid_argument);
+  }
+  // Two temperatures, 30 K apart: the first order only, though the quadratic terms were asked
+  // for; the secant of each part's scale (the reference recording's rows carry no drift),
+  // 4e-3 - 2e-6 * 30 per K for the permittivity.
+  const TemperatureFitResult secant =
+      fit_temperature(at25.model, {recordings[0], recordings[2]}, 25.0);
+  EXPECT_FALSE(secant.quadratic);
+  EXPECT_NEAR(secant.coefficients.sensor.linear.per_k, 4e-3 - 2e-6 * 30.0, 1e-7);
+  EXPECT_NEAR(secant.coefficients.sensor.loop.per_k, -4e-3 + 3e-6 * 30.0, 1e-7);
+  // A recording whose columns differ in length is named by its index.
+  recordings[1].strain = recordings[1].strain.first(100);
+  try {
+    static_cast<void>(fit_temperature(at25.model, recordings, 25.0));
+    ADD_FAILURE() << "a recording with columns of different lengths was fitted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("recording 1"), std::string::npos) << e.what();
+  }
 }
 
 TEST(TemperatureFit, RefusesWhatItCannotFit) {

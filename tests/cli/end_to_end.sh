@@ -50,6 +50,21 @@ awk -v v="$per_k" 'BEGIN { exit !(v != "" && v + 0 > 2e-3 && v + 0 < 6e-3) }' ||
   fail "fitted permittivity per K '$per_k' (the plant's 4e-3)"
 "$bin" reconstruct --model "$work/mt.yaml" --recording "$work/rw.csv" --adapt \
   --temperature-column temp --out "$work/rt.csv" >/dev/null || fail "reconstruct with coefficients"
+# Recordings of the same plant held near 25, 40 and 55 degC (each drifting by 0.5 K, too little
+# to fit on alone; a constant one writes no temp column) fit the coefficients together.
+for c in 25 40 55; do
+  sed "s/start_degc: 25.0, end_degc: 55.0/start_degc: $c.0, end_degc: $c.5/" "$work/warm.yaml" \
+    >"$work/at$c.yaml"
+  "$bin" plant --config "$work/at$c.yaml" --excitation decaying --seed 2 --out "$work/at$c.csv" \
+    >/dev/null
+done
+"$bin" identify --recording "$work/r.csv" --structure hysteresis-creep --out "$work/mf.yaml" \
+  --plays 12 --eigenvalues 3 --temperature-recording "$work/at25.csv" "$work/at40.csv" \
+  --temperature-recording "$work/at55.csv" >"$work/identify-fixed.txt" ||
+  fail "identify on recordings at three temperatures"
+per_k=$(sed -n 's/^  sensor   permittivity \([-+0-9.e]*\) .*/\1/p' "$work/identify-fixed.txt")
+awk -v v="$per_k" 'BEGIN { exit !(v != "" && v + 0 > 2e-3 && v + 0 < 6e-3) }' ||
+  fail "permittivity per K from three fixed temperatures '$per_k' (the plant's 4e-3)"
 
 "$bin" simulate --model "$work/m.yaml" --recording "$work/r.csv" --out "$work/sim.csv" >/dev/null
 has_column "$work/sim.csv" D_model || fail "simulate wrote no D_model"
