@@ -81,6 +81,16 @@ void expect_polynomial(const models::TemperaturePolynomial& fitted,
   EXPECT_NEAR(fitted.per_k2, want.per_k2, 1e-8);
 }
 
+void expect_coefficients(const models::TemperatureCoefficients& fitted,
+                         const models::TemperatureCoefficients& want) {
+  for (const auto side :
+       {&models::TemperatureCoefficients::sensor, &models::TemperatureCoefficients::actuator}) {
+    expect_polynomial((fitted.*side).linear, (want.*side).linear);
+    expect_polynomial((fitted.*side).loop, (want.*side).loop);
+    expect_polynomial((fitted.*side).coupling, (want.*side).coupling);
+  }
+}
+
 TEST(TemperatureFit, RecoversKnownCoefficients) {
   const Ramp r = ramp(40000);
   const TemperatureFitResult fit = fit_temperature(r.model, {r.e, r.d, r.t, r.s, r.temp}, 25.0);
@@ -88,12 +98,7 @@ TEST(TemperatureFit, RecoversKnownCoefficients) {
   EXPECT_EQ(fit.samples, r.e.size());
   EXPECT_TRUE(fit.quadratic);
   EXPECT_EQ(fit.coefficients.reference_degc, 25.0);
-  expect_polynomial(fit.coefficients.sensor.linear, want.sensor.linear);
-  expect_polynomial(fit.coefficients.sensor.loop, want.sensor.loop);
-  expect_polynomial(fit.coefficients.sensor.coupling, want.sensor.coupling);
-  expect_polynomial(fit.coefficients.actuator.linear, want.actuator.linear);
-  expect_polynomial(fit.coefficients.actuator.loop, want.actuator.loop);
-  expect_polynomial(fit.coefficients.actuator.coupling, want.actuator.coupling);
+  expect_coefficients(fit.coefficients, want);
   EXPECT_LT(fit.sensor_rms_after, 1e-6 * fit.sensor_rms_before);
   EXPECT_LT(fit.actuator_rms_after, 1e-6 * fit.actuator_rms_before);
   // On the estimator's increments the synthetic sensor's drift is the levels' (its parts scale
@@ -122,12 +127,7 @@ TEST(TemperatureFit, RecordingsAtSeveralFixedTemperaturesFitTogether) {
   const models::TemperatureCoefficients want = truth();
   EXPECT_EQ(fit.samples, 60000U);
   EXPECT_TRUE(fit.quadratic);  // three temperatures
-  expect_polynomial(fit.coefficients.sensor.linear, want.sensor.linear);
-  expect_polynomial(fit.coefficients.sensor.loop, want.sensor.loop);
-  expect_polynomial(fit.coefficients.sensor.coupling, want.sensor.coupling);
-  expect_polynomial(fit.coefficients.actuator.linear, want.actuator.linear);
-  expect_polynomial(fit.coefficients.actuator.loop, want.actuator.loop);
-  expect_polynomial(fit.coefficients.actuator.coupling, want.actuator.coupling);
+  expect_coefficients(fit.coefficients, want);
   EXPECT_LT(fit.sensor_rms_after, 1e-6 * fit.sensor_rms_before);
   for (const TemperatureFitInput& one : recordings) {
     EXPECT_THROW(static_cast<void>(fit_temperature(at25.model, one, 25.0)), std::invalid_argument);

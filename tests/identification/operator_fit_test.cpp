@@ -54,18 +54,27 @@ TEST(OperatorFit, LinearStructureRecoversPermittivityAndCoupling) {
   EXPECT_NEAR(m.offset, 0.0, 1e-9);
 }
 
-TEST(OperatorFit, HysteresisCreepWithRemanentStartFitsFromTheFirstCycle) {
+// A typical stack's charge with creep and dead zones, and the structure fitted to it (other sizes).
+HysteresisCreep::Params stack_truth() {
   operators::TypicalStackSize size;
   size.plays = 12;
   size.dead_zones = 3;
   size.eigenvalues = 4;
-  const HysteresisCreep::Params truth = operators::typical_stack_charge(size);
-  const double range_guess = 0.1;
-  const Data d = make_data(truth, 3e-10, 60000, 1e-4 * range_guess, 2);
+  return operators::typical_stack_charge(size);
+}
+
+OperatorStructure stack_structure() {
   OperatorStructure s;
   s.plays = 16;
   s.eigenvalues = 5;
   s.dead_zones = 3;
+  return s;
+}
+
+TEST(OperatorFit, HysteresisCreepWithRemanentStartFitsFromTheFirstCycle) {
+  const double range_guess = 0.1;
+  const Data d = make_data(stack_truth(), 3e-10, 60000, 1e-4 * range_guess, 2);
+  const OperatorStructure s = stack_structure();
   const OperatorModel m = fit_operator({d.e, {d.t}, d.y, kTs}, s);
   std::vector<double> y(d.y.size());
   simulate_operator(m, d.e, {d.t}, y);
@@ -83,16 +92,8 @@ TEST(OperatorFit, HysteresisCreepWithRemanentStartFitsFromTheFirstCycle) {
 // A given start replaces the search: from the start the search chose, the same fit; from another
 // start, a fit from that one (the diagnosis's trials take their null's start).
 TEST(OperatorFit, AGivenStartIsFittedFromWithoutASearch) {
-  operators::TypicalStackSize size;
-  size.plays = 12;
-  size.dead_zones = 3;
-  size.eigenvalues = 4;
-  const HysteresisCreep::Params truth = operators::typical_stack_charge(size);
-  const Data d = make_data(truth, 3e-10, 30000, 1e-5, 3);
-  OperatorStructure s;
-  s.plays = 16;
-  s.eigenvalues = 5;
-  s.dead_zones = 3;
+  const Data d = make_data(stack_truth(), 3e-10, 30000, 1e-5, 3);
+  OperatorStructure s = stack_structure();
   const OperatorModel searched = fit_operator({d.e, {d.t}, d.y, kTs}, s);
   ASSERT_GT(searched.history.size(), 1U);  // the remanent start, not the demagnetised one
   s.start = searched.history;
