@@ -304,8 +304,18 @@ std::optional<Reidentified> identified_whole(const Judge& judge,
   return r;
 }
 
+// A family's winner identified in full, from the start its own search picks. The null's start
+// chooses among the family cheaply; the winner's own start decides how it fits and forecasts
+// where it is compared and judged (a mode undone reshapes the response of the first sweep,
+// where the start is read: the 1 Hz set's ringing lost to a delay from the null's start).
+Trial in_full(const Judge& judge, Trial best) {
+  if (best.forecast.empty()) return best;
+  Trial full = judge.trial(best.effect);
+  return full.forecast.empty() ? best : full;
+}
+
 // The effect of one family that fits the first half best: a coarse grid, then `refine`'s
-// neighbours of the best, each trial from `start` (the null's).
+// neighbours of the best, each trial from `start` (the null's); the winner then in full.
 template <typename Refine>
 Trial best_of(const Judge& judge, const std::vector<models::ChannelCorrection>& grid,
               Refine&& refine, const std::vector<double>& start) {
@@ -319,7 +329,7 @@ Trial best_of(const Judge& judge, const std::vector<models::ChannelCorrection>& 
     Trial t = judge.trial(effect, start);
     if (t.first_half_sse < best.first_half_sse) best = std::move(t);
   }
-  return best;
+  return in_full(judge, std::move(best));
 }
 
 // The effect's backcast against the null's by the rules of a round: each side identified on
@@ -519,6 +529,7 @@ std::optional<Reidentified> reidentified_lag(const models::TransducerModel& mode
       Trial t = judge.trial(effect, null.start);
       if (t.first_half_sse < best.first_half_sse) best = std::move(t);
     }
+    best = in_full(judge, std::move(best));
   }
   if (best.forecast.empty()) return std::nullopt;
   // A fast, damped mode on S lags like a delay in the excitation's band; its resonance bends
