@@ -206,21 +206,25 @@ void describe_stress(Finding& f, const Evidence& e) {
   const std::string& tail = e.tail;
   const double pct = e.pct;
   if (c.stress_drive_per_pa != 0.0) {
-    // Each part of the sensed response with its own change per MPa, the permittivity's (T x) at
-    // the recording's RMS drive, the whole response's (T r), the coupling's (T^2).
+    // Each part of the response with its own change per MPa, the drive's linear part (T x) at
+    // the recording's RMS drive, the whole response's (T r) and, on the sensed channel, the
+    // coupling's (T^2). On the strain, T x beside T r is the loop moving apart from the coupling.
     double x_rms = 0.0;
     for (const double x : s.drive)
       x_rms += x * x / static_cast<double>(s.drive.size());
     x_rms = std::sqrt(x_rms);
-    f.evidence = "the recorded " + n +
-                 format(
-                     " follows the stress in each part of its response: the field's linear "
-                     "part changes by %.3g %% of range per MPa at the RMS field, the whole "
-                     "response by %.3g %% per MPa, and the coupling bends with T^2 (%.3g %% of "
-                     "range at 1 MPa)",
-                     c.stress_drive_per_pa * 1e6 * x_rms * pct, 100.0 * c.stress_gain_per_pa * 1e6,
-                     c.stress_quadratic_per_pa2 * 1e12 * pct) +
-                 tail;
+    f.evidence =
+        "the recorded " + n +
+        format(
+            " follows the stress in each part of its response: the field's linear "
+            "part changes by %.3g %% of range per MPa at the RMS field and the whole "
+            "response by %.3g %% per MPa",
+            c.stress_drive_per_pa * 1e6 * x_rms * pct, 100.0 * c.stress_gain_per_pa * 1e6) +
+        (c.stress_quadratic_per_pa2 != 0.0
+             ? format(", and the coupling bends with T^2 (%.3g %% of range at 1 MPa)",
+                      c.stress_quadratic_per_pa2 * 1e12 * pct)
+             : std::string(" (the loop moves apart from the coupling as the stress changes)")) +
+        tail;
   } else if (c.stress_quadratic_per_pa2 != 0.0) {
     const double t = std::max(std::abs(*std::max_element(s.stress.begin(), s.stress.end())),
                               std::abs(*std::min_element(s.stress.begin(), s.stress.end())));
@@ -378,6 +382,14 @@ const std::vector<Candidate>& candidates() {
         CorrectionTerm::kOffset},
        true,
        false,
+       Needs::kStress,
+       &describe_stress},
+      // ... and on the strain the loop apart from the coupling: a loop that grows with stress
+      // scales the hysteretic part of the response alone, T (r - a x), which T r and T x span.
+      {"stress_dependence",
+       {CorrectionTerm::kStress, CorrectionTerm::kStressDrive, CorrectionTerm::kOffset},
+       false,
+       true,
        Needs::kStress,
        &describe_stress},
       {"permittivity_nonlinearity",

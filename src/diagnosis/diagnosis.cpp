@@ -362,12 +362,18 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
   const std::size_t blocks = std::max<std::size_t>(2, options.blocks);
   const Context context{model, base, s, options, blocks, field, has_sensor};
   Result first = diagnose_channels(context, channels, outputs, std::nullopt);
-  const auto is_stress = [](const Finding& f) { return f.effect == "stress_dependence"; };
-  if (!std::all_of(first.findings.begin(), first.findings.end(), is_stress)) return first;
+  // A generic loop correction is part of what the structure below re-identifies (its loop).
+  const auto stress_or_loop = [](const Finding& f) {
+    return f.effect == "stress_dependence" ||
+           std::any_of(candidates().begin(), candidates().end(),
+                       [&](const Candidate& c) { return c.generic && f.effect == c.effect; });
+  };
+  if (!std::all_of(first.findings.begin(), first.findings.end(), stress_or_loop)) return first;
   // A loop and coupling that move with the stress bend an affine base: where nothing but the
-  // stress is named, judged for the whole model (it replaces both sides) by re-identification
-  // with the stress-hysteresis structure (the corrections carry a coupling's change, not a loop
-  // that moves with T); then each channel's rounds run on it and no side is re-identified again.
+  // stress (or the loop's generic shape beside it) is named, judged for the whole model (it
+  // replaces both sides) by re-identification with the stress-hysteresis structure (the
+  // corrections carry a coupling's change, not a loop that moves with T); then each channel's
+  // rounds run on it and no side is re-identified again.
   const std::optional<StressReidentified> stressed =
       reidentified_stress(model, s, channels, options);
   if (!stressed) return first;
