@@ -140,7 +140,7 @@ class Judge {
     (ch_.sensed ? t.sensed : t.strain) = part(y);
     t.stress = part(s_.stress);
     t.sample_time = s_.sample_time;
-    identification::IdentificationOptions options = identification::defaults_for(structure_);
+    identification::IdentificationOptions options = reidentification_options(structure_);
     options.start = start;
     return identification::identify(t, structure_, options);
   }
@@ -202,6 +202,12 @@ models::TransducerModel first_half_fit(models::Structure structure, const Signal
   models::TransducerModel m = judge.identify(judge.undone({}), judge.half());
   ch.first_half->keep(structure, m);
   return m;
+}
+
+identification::IdentificationOptions reidentification_options(models::Structure structure) {
+  identification::IdentificationOptions options = identification::defaults_for(structure);
+  options.max_rows = kReidentifiedRows;
+  return options;
 }
 
 const Candidate& candidate_using(CorrectionTerm term) {

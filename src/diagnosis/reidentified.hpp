@@ -24,6 +24,7 @@
 // Only the sensor side of field-drive models with one side per channel (not vectorial).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -32,6 +33,7 @@
 #include "channel_data.hpp"
 #include "held_out.hpp"
 #include "selfsense/diagnosis/diagnosis.hpp"
+#include "selfsense/identification/transducer_fit.hpp"
 
 namespace selfsense::diagnosis::detail {
 
@@ -146,6 +148,17 @@ struct StressReidentified {
 // (ChannelData::first_half). Throws std::invalid_argument where no identification exists.
 [[nodiscard]] models::TransducerModel first_half_fit(models::Structure structure, const Signals& s,
                                                      const ChannelData& ch);
+
+// The options of every identification a judgement runs: the structure's defaults, with each
+// least-squares fit over at most kReidentifiedRows samples (IdentificationOptions::max_rows:
+// every m-th of a longer record). A judgement compares forecasts whose residual is model error
+// far above the fit's own noise; with at most ~100 parameters per side, 2e5 rows leave the
+// parameters' estimation variance below p / rows = 5e-4 of the residual's, and a 1e6-sample
+// record's halves cost a third (docs/diagnose.md, "Speed"). Records up to 2e5 samples (the
+// independent draws', every test's) are fitted on every sample as before.
+inline constexpr std::size_t kReidentifiedRows = 200000;
+[[nodiscard]] identification::IdentificationOptions reidentification_options(
+    models::Structure structure);
 
 // The first candidate that carries `term`.
 [[nodiscard]] const Candidate& candidate_using(identification::CorrectionTerm term);

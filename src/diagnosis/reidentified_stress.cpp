@@ -34,7 +34,7 @@ models::TransducerModel identified(const Signals& s, Structure structure, std::s
   t.stress = first(s.stress);
   t.strain = first(s.strain);
   t.sample_time = s.sample_time;
-  return identification::identify(t, structure, identification::defaults_for(structure));
+  return identification::identify(t, structure, reidentification_options(structure));
 }
 
 std::vector<double> channel_of(const Outputs& o, const ChannelData& ch) {

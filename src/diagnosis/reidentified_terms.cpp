@@ -59,7 +59,7 @@ class Identifier {
     t.stress = s_.stress.empty() ? s_.stress : s_.stress.first(k);
     t.sample_time = s_.sample_time;
     return identification::identify(t, model_.structure,
-                                    identification::defaults_for(model_.structure));
+                                    reidentification_options(model_.structure));
   }
 
   [[nodiscard]] std::vector<double> output_of(const models::TransducerModel& m) const {

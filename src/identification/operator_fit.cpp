@@ -40,12 +40,22 @@ BoundedLeastSquaresSolution solve(const GramAccumulator& acc, const Bounds& boun
        Eigen::Map<const Eigen::VectorXd>(bounds.lower.data(), bounds.size())});
 }
 
-// Streams rows over samples [from, count) (the operator still runs from sample 0):
-// fill(k, phi, row, target) writes one row, given the operator columns phi of sample k.
+// Which samples are rows of the normal equations: every `step`-th (k % step == 0, so ranges
+// accumulated apart agree), each weighted by sqrt(step) so that the sums keep the units of
+// every sample (OperatorStructure::row_step).
+struct RowStep {
+  std::size_t step{1};
+  [[nodiscard]] bool keeps(std::size_t k) const { return k % step == 0; }
+  [[nodiscard]] double weight() const { return std::sqrt(static_cast<double>(step)); }
+};
+
+// Streams rows over samples [from, count) (the operator still runs from sample 0 through
+// every sample): fill(k, phi, row, target) writes one row, given the operator columns phi of
+// sample k.
 template <typename Fill>
 GramAccumulator accumulate(const OperatorBasis& basis, std::span<const double> x,
                            std::span<const double> history, std::size_t count, Eigen::Index cols,
-                           Fill fill, std::size_t from = 0) {
+                           RowStep rows, Fill fill, std::size_t from = 0) {
   GramAccumulator acc(cols);
   RegressorStream stream(basis, history);
   for (std::size_t k = 0; k < from && k < count; ++k)
@@ -53,9 +63,16 @@ GramAccumulator accumulate(const OperatorBasis& basis, std::span<const double> x
   RowBlock block(kBlockRows, cols);
   Eigen::VectorXd target(kBlockRows);
   Eigen::Index row = 0;
+  const double weight = rows.weight();
   for (std::size_t k = from; k < count; ++k) {
-    fill(k, stream.next(x[k]),
-         std::span<double>(block.row(row).data(), static_cast<std::size_t>(cols)), target(row));
+    const std::span<const double> phi = stream.next(x[k]);
+    if (!rows.keeps(k)) continue;
+    fill(k, phi, std::span<double>(block.row(row).data(), static_cast<std::size_t>(cols)),
+         target(row));
+    if (rows.step > 1) {
+      block.row(row) *= weight;
+      target(row) *= weight;
+    }
     if (++row == kBlockRows) {
       acc.add(block, target);
       row = 0;
@@ -76,8 +93,9 @@ struct Fit {
 
 class Fitter {
  public:
-  Fitter(const OperatorSignals& s, const OperatorBasis& basis, double weight_floor, bool offset)
-      : s_(s), basis_(basis), floor_(weight_floor), offset_(offset) {}
+  Fitter(const OperatorSignals& s, const OperatorBasis& basis, double weight_floor, bool offset,
+         RowStep rows)
+      : s_(s), basis_(basis), floor_(weight_floor), offset_(offset), rows_(rows) {}
 
   [[nodiscard]] std::size_t extras() const { return s_.linear_inputs.size() + (offset_ ? 1 : 0); }
 
@@ -92,7 +110,7 @@ class Fitter {
     const std::size_t ops = basis_.columns();
     const auto cols = static_cast<Eigen::Index>(ops + extras());
     return accumulate(
-        basis_, s_.input, history, to, cols,
+        basis_, s_.input, history, to, cols, rows_,
         [&](std::size_t k, auto phi, auto row, double& y) {
           std::copy(phi.begin(), phi.end(), row.begin());
           fill_extras(k, row.subspan(ops), 1.0);
@@ -120,7 +138,7 @@ class Fitter {
     const std::size_t shape_cols = dz.columns() - 1;
     std::vector<double> b(dz.columns());
     const GramAccumulator acc = accumulate(basis_, s_.input, history_, inner.size(),
-                                           static_cast<Eigen::Index>(ops + shape_cols),
+                                           static_cast<Eigen::Index>(ops + shape_cols), rows_,
                                            [&](std::size_t k, auto phi, auto row, double& y) {
                                              std::copy(phi.begin(), phi.end(), row.begin());
                                              dz.evaluate(inner[k], b);
@@ -151,11 +169,17 @@ class Fitter {
     RowBlock block(kBlockRows, cols);
     Eigen::VectorXd target(kBlockRows);
     Eigen::Index row = 0;
+    const double weight = rows_.weight();
     for (std::size_t k = 0; k < inner.size(); ++k) {
+      if (!rows_.keeps(k)) continue;
       const std::span<double> r(block.row(row).data(), static_cast<std::size_t>(cols));
       dz.evaluate(inner[k], r.first(shape_cols));
       fill_extras(k, r.subspan(shape_cols), 1.0);
       target(row) = s_.output[k];
+      if (rows_.step > 1) {
+        block.row(row) *= weight;
+        target(row) *= weight;
+      }
       if (++row == kBlockRows) {
         acc.add(block, target);
         row = 0;
@@ -183,7 +207,7 @@ class Fitter {
     const std::size_t ops = basis_.columns();
     const auto cols = static_cast<Eigen::Index>(ops + extras());
     const GramAccumulator acc =
-        accumulate(basis_, s_.input, history_, v0.size(), cols,
+        accumulate(basis_, s_.input, history_, v0.size(), cols, rows_,
                    [&](std::size_t k, auto phi, auto row, double& y) {
                      const double slope = shape.slope(v0[k]);
                      for (std::size_t i = 0; i < ops; ++i)
@@ -267,6 +291,7 @@ class Fitter {
   const OperatorBasis& basis_;
   double floor_;
   bool offset_;
+  RowStep rows_;
   std::vector<double> history_{};
 };
 
@@ -333,7 +358,8 @@ OperatorBasis basis_for(const OperatorSignals& signals, const OperatorStructure&
 // (rising and falling starts can be close). creep_lags: score with the creep lags of the
 // linear term, or with the plays alone.
 std::vector<double> estimate_history(const OperatorSignals& signals, const OperatorBasis& basis,
-                                     double weight_floor, bool offset, bool creep_lags) {
+                                     double weight_floor, bool offset, RowStep rows,
+                                     bool creep_lags) {
   const std::size_t n = signals.input.size();
   const auto [x_lo, x_hi] = std::minmax_element(signals.input.begin(), signals.input.end());
   // The start state matters until the input has swept its whole range (wiping-out), so
@@ -352,7 +378,7 @@ std::vector<double> estimate_history(const OperatorSignals& signals, const Opera
   } else if (scoring.creep_rows.size() > 1) {
     scoring.creep_rows.erase(scoring.creep_rows.begin() + 1, scoring.creep_rows.end());
   }
-  const Fitter scorer(signals, scoring, weight_floor, offset);
+  const Fitter scorer(signals, scoring, weight_floor, offset, rows);
   const GramAccumulator shared = scorer.linear_gram({&signals.input.front(), 1}, sweep, head);
   const auto residual = [&](const std::vector<double>& h) {
     GramAccumulator acc = scorer.linear_gram(h, 0, sweep);
@@ -396,12 +422,13 @@ std::vector<double> estimate_history(const OperatorSignals& signals, const Opera
 // whole basis picks a turning point below the range: 0.42 % (docs/identification.md).
 std::vector<std::vector<double>> start_finalists(const OperatorSignals& signals,
                                                  const OperatorBasis& basis, double weight_floor,
-                                                 bool offset, const std::vector<double>& first) {
+                                                 bool offset, RowStep rows,
+                                                 const std::vector<double>& first) {
   std::vector<std::vector<double>> finalists;
   if (!first.empty()) finalists.push_back(first);
-  finalists.push_back(estimate_history(signals, basis, weight_floor, offset, true));
+  finalists.push_back(estimate_history(signals, basis, weight_floor, offset, rows, true));
   if (basis.creep() > 0)
-    finalists.push_back(estimate_history(signals, basis, weight_floor, offset, false));
+    finalists.push_back(estimate_history(signals, basis, weight_floor, offset, rows, false));
   finalists.push_back({signals.input.front()});
   for (std::vector<double>& c : outside_candidates(signals.input))
     finalists.push_back(std::move(c));
@@ -485,14 +512,16 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
   // W_i >= floor keeps the PI invertible with margin far below any useful weight.
   const double weight_floor = 1e-6 * y_range / x_range;
   const OperatorBasis basis = basis_for(signals, structure, x_range);
-  Fitter fitter(signals, basis, weight_floor, structure.fit_offset);
+  const RowStep rows{std::max<std::size_t>(1, structure.row_step)};
+  Fitter fitter(signals, basis, weight_floor, structure.fit_offset, rows);
 
   const bool search = structure.estimate_history && structure.plays > 0 && structure.start.empty();
   std::vector<double> history{signals.input.front()};
   if (!structure.start.empty()) history = structure.start;
   if (search) {
-    history = best_start(fitter, signals.input,
-                         start_finalists(signals, basis, weight_floor, structure.fit_offset, {}));
+    history =
+        best_start(fitter, signals.input,
+                   start_finalists(signals, basis, weight_floor, structure.fit_offset, rows, {}));
   }
   Fit fit = fit_with_history(fitter, history, structure, n);
   if (basis.hinges() > 0 && structure.dead_zones > 0) {
@@ -502,7 +531,7 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
     OperatorBasis plain = basis;
     plain.hinge_rows.clear();
     plain.hinge_levels.clear();
-    Fitter plain_fitter(signals, plain, weight_floor, structure.fit_offset);
+    Fitter plain_fitter(signals, plain, weight_floor, structure.fit_offset, rows);
     Fit candidate = fit_with_history(plain_fitter, history, structure, n);
     candidate.theta.conservativeResize(static_cast<Eigen::Index>(basis.columns()));
     candidate.theta.tail(static_cast<Eigen::Index>(basis.hinges())).setZero();
@@ -521,9 +550,10 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
     // operator is linear, and keep the better fit.
     const std::vector<double> v = inner_output(signals, fit);
     const OperatorSignals inner{signals.input, {}, v, signals.sample_time};
-    const Fitter inner_fitter(inner, basis, weight_floor, true);
-    std::vector<double> second = best_start(
-        inner_fitter, signals.input, start_finalists(inner, basis, weight_floor, true, history));
+    const Fitter inner_fitter(inner, basis, weight_floor, true, rows);
+    std::vector<double> second =
+        best_start(inner_fitter, signals.input,
+                   start_finalists(inner, basis, weight_floor, true, rows, history));
     if (second != history) {
       Fit refit = fit_with_history(fitter, second, structure, n);
       if (refit.rss < fit.rss) {

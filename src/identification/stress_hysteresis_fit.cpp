@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -20,18 +21,20 @@ using RowBlock = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::Ro
 class SideProblem {
  public:
   SideProblem(const operators::OperatorBasis& basis, std::span<const double> e,
-              std::span<const double> t, std::span<const double> y)
-      : basis_(basis), e_(e), t_(t), y_(y) {}
+              std::span<const double> t, std::span<const double> y, std::size_t row_step)
+      : basis_(basis), e_(e), t_(t), y_(y), row_step_(std::max<std::size_t>(1, row_step)) {}
 
   [[nodiscard]] std::span<const double> field() const { return e_; }
   [[nodiscard]] std::span<const double> stress() const { return t_; }
   [[nodiscard]] std::span<const double> output() const { return y_; }
+  [[nodiscard]] std::size_t row_step() const { return row_step_; }
 
   [[nodiscard]] Eigen::Index columns() const {
     return static_cast<Eigen::Index>(2 * basis_.columns() + 3);
   }
 
-  // Rows [from, to) with the plays started from `history` (they still run from sample 0).
+  // Rows [from, to) with the plays started from `history` (they still run from sample 0), every
+  // row_step-th weighted by sqrt(row_step) (OperatorStructure::row_step).
   [[nodiscard]] GramAccumulator gram(std::span<const double> history, std::size_t from,
                                      std::size_t to) const {
     const std::size_t p = basis_.columns();
@@ -42,9 +45,10 @@ class SideProblem {
     RowBlock block(kBlock, cols);
     Eigen::VectorXd target(kBlock);
     Eigen::Index row = 0;
+    const double weight = std::sqrt(static_cast<double>(row_step_));
     for (std::size_t k = 0; k < to; ++k) {
       const std::span<const double> q = stream.next(e_[k]);
-      if (k < from) continue;
+      if (k < from || k % row_step_ != 0) continue;
       for (std::size_t i = 0; i < p; ++i) {
         block(row, static_cast<Eigen::Index>(i)) = q[i];
         block(row, static_cast<Eigen::Index>(p + i)) = t_[k] * q[i];
@@ -53,6 +57,10 @@ class SideProblem {
       block(row, cols - 2) = t_[k] * t_[k];
       block(row, cols - 1) = 1.0;
       target(row) = y_[k];
+      if (row_step_ > 1) {
+        block.row(row) *= weight;
+        target(row) *= weight;
+      }
       if (++row == kBlock) {
         acc.add(block, target);
         row = 0;
@@ -93,6 +101,7 @@ class SideProblem {
  private:
   const operators::OperatorBasis& basis_;
   std::span<const double> e_, t_, y_;
+  std::size_t row_step_;
 };
 
 // The remanent state, in two steps. The operator fit's search (affine in T, plays only) ranks
@@ -108,6 +117,7 @@ std::vector<double> estimate_history(const SideProblem& problem, double sample_t
   const std::span<const double> e = problem.field();
   OperatorStructure plays_only;
   plays_only.plays = plays;
+  plays_only.row_step = problem.row_step();
   const std::vector<std::span<const double>> stress{problem.stress()};
   std::vector<double> history =
       fit_operator({e, stress, problem.output(), sample_time}, plays_only).history;
@@ -128,12 +138,10 @@ std::vector<double> estimate_history(const SideProblem& problem, double sample_t
 
 }  // namespace
 
-models::StressHysteresisModel fit_stress_hysteresis(std::span<const double> e,
-                                                    std::span<const double> t,
-                                                    std::span<const double> d,
-                                                    std::span<const double> s, double sample_time,
-                                                    std::size_t plays,
-                                                    const StressCreepSizes& creep) {
+models::StressHysteresisModel fit_stress_hysteresis(
+    std::span<const double> e, std::span<const double> t, std::span<const double> d,
+    std::span<const double> s, double sample_time, std::size_t plays, const StressCreepSizes& creep,
+    std::size_t row_step) {
   const std::size_t n = e.size();
   if (n < 2 || t.size() != n || (!d.empty() && d.size() != n) || (!s.empty() && s.size() != n) ||
       (d.empty() && s.empty())) {
@@ -167,11 +175,11 @@ models::StressHysteresisModel fit_stress_hysteresis(std::span<const double> e,
     m = models::with_creep_gains(std::move(m));
   }
   // The history shows most clearly in the sensed channel (larger loops, exact charge).
-  const SideProblem reference(m.basis, e, t, d.empty() ? s : d);
+  const SideProblem reference(m.basis, e, t, d.empty() ? s : d, row_step);
   m.history =
       plays > 0 ? estimate_history(reference, sample_time, plays) : std::vector<double>{e.front()};
-  if (!d.empty()) m.sensor = SideProblem(m.basis, e, t, d).fit(m.history);
-  if (!s.empty()) m.actuator = SideProblem(m.basis, e, t, s).fit(m.history);
+  if (!d.empty()) m.sensor = SideProblem(m.basis, e, t, d, row_step).fit(m.history);
+  if (!s.empty()) m.actuator = SideProblem(m.basis, e, t, s, row_step).fit(m.history);
   const double span = *t_hi - *t_lo;
   m.stress_min = *t_lo - 0.1 * span;
   m.stress_max = *t_hi + 0.1 * span;

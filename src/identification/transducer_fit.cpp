@@ -19,7 +19,12 @@
 namespace selfsense::identification {
 namespace {
 
-OperatorStructure structure_of(const IdentificationOptions& o, bool creep) {
+// OperatorStructure::row_step for n samples under IdentificationOptions::max_rows.
+std::size_t row_step_for(const IdentificationOptions& o, std::size_t n) {
+  return o.max_rows == 0 ? 1 : std::max<std::size_t>(1, (n + o.max_rows - 1) / o.max_rows);
+}
+
+OperatorStructure structure_of(const IdentificationOptions& o, bool creep, std::size_t n) {
   OperatorStructure s;
   s.plays = o.plays;
   s.eigenvalues = creep ? o.eigenvalues : 0;
@@ -30,6 +35,7 @@ OperatorStructure structure_of(const IdentificationOptions& o, bool creep) {
   s.slowest_eigenvalue = o.slowest_eigenvalue;
   s.bias_levels = o.bias_levels;
   s.start = o.start;
+  s.row_step = row_step_for(o, n);
   return s;
 }
 
@@ -111,7 +117,7 @@ OperatorModel fit_side(const OperatorSignals& s, OperatorStructure structure,
 // is not nested in that of m > n, and a denser grid matters (a generator off the grid: T_hat
 // 3.8 / 2.4 / 0.11 % on new data with 16 / 24 / 48 plays, docs/identification.md).
 std::size_t choose_stress_plays(const TransducerSignals& s, std::size_t fallback,
-                                const StressCreepSizes& creep) {
+                                const StressCreepSizes& creep, std::size_t row_step) {
   const std::size_t n = s.drive.size();
   const std::size_t split = n - n / 4;
   const auto head = [split](std::span<const double> v) { return v.empty() ? v : v.first(split); };
@@ -126,8 +132,9 @@ std::size_t choose_stress_plays(const TransducerSignals& s, std::size_t fallback
   };
   if (!varies(head(s.stress)) || !varies(head(s.drive))) return fallback;  // nothing to fit
   for (const std::size_t plays : kStressPlayCandidates) {
-    const models::StressHysteresisModel m = fit_stress_hysteresis(
-        head(s.drive), head(s.stress), head(s.sensed), head(s.strain), s.sample_time, plays, creep);
+    const models::StressHysteresisModel m =
+        fit_stress_hysteresis(head(s.drive), head(s.stress), head(s.sensed), head(s.strain),
+                              s.sample_time, plays, creep, row_step);
     double score = 0.0;
     if (m.sensor) {
       models::StressHysteresisReconstructor rec(m);
@@ -200,11 +207,13 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
     }
     const StressCreepSizes creep{options.eigenvalues, options.creep_plays,
                                  options.fastest_eigenvalue, options.slowest_eigenvalue};
+    const std::size_t row_step = row_step_for(options, n);
     const std::size_t plays = options.choose_plays && n >= 8
-                                  ? choose_stress_plays(signals, options.plays, creep)
+                                  ? choose_stress_plays(signals, options.plays, creep, row_step)
                                   : options.plays;
-    model.vectorial = fit_stress_hysteresis(signals.drive, signals.stress, signals.sensed,
-                                            signals.strain, signals.sample_time, plays, creep);
+    model.vectorial =
+        fit_stress_hysteresis(signals.drive, signals.stress, signals.sensed, signals.strain,
+                              signals.sample_time, plays, creep, row_step);
     return model;
   }
   std::vector<std::span<const double>> linear;
@@ -233,14 +242,14 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
   if (usable(signals.sensed)) {
     work.emplace_back([&] {
       sensor = fit_side({signals.drive, linear, signals.sensed, signals.sample_time},
-                        structure_of(options, creep), options, choose);
+                        structure_of(options, creep, n), options, choose);
     });
   }
   if (usable(signals.strain)) {
     work.emplace_back([&] {
       actuator = fit_side({signals.drive, actuator_inputs, signals.strain, signals.sample_time},
-                          linear_side ? OperatorStructure{} : structure_of(options, creep), options,
-                          choose && !linear_side);
+                          linear_side ? OperatorStructure{} : structure_of(options, creep, n),
+                          options, choose && !linear_side);
     });
   }
   if (run && work.size() > 1) {

@@ -172,5 +172,28 @@ TEST(StressHysteresisOptimum, ChosenSizeReachesTheNoiseFloorOnANewRecording) {
   EXPECT_LE(affine_val.s_hat, 0.043);
 }
 
+// At most a third of the samples as rows of each fit (IdentificationOptions::max_rows: every 3rd,
+// the diagnosis's re-identifications of long records): the same size chosen and the same floor
+// on the new recording, within a tenth of the fit on every row.
+TEST(StressHysteresisOptimum, EveryThirdRowReachesTheSameFloor) {
+  const test::RecordingPair& r = recordings();
+  const TransducerSignals fit{r.fit.e, r.fit.d, r.fit.t, r.fit.s, kTs};
+  IdentificationOptions options = defaults_for(models::Structure::kStressHysteresis);
+  const models::TransducerModel every =
+      identify(fit, models::Structure::kStressHysteresis, options);
+  options.max_rows = kFitSamples / 3;
+  const models::TransducerModel third =
+      identify(fit, models::Structure::kStressHysteresis, options);
+  const Figures every_val = reconstruct(*every.vectorial, r.validation);
+  const Figures third_val = reconstruct(*third.vectorial, r.validation);
+  print("every row, validation", every_val);
+  print("every third row, validation", third_val);
+  EXPECT_NE(third.vectorial->sensor->base, every.vectorial->sensor->base);  // other rows
+  EXPECT_EQ(third.vectorial->basis.thresholds.size(), 49U);
+  EXPECT_LE(third_val.t_hat, 1.1 * every_val.t_hat);
+  EXPECT_LE(third_val.s_hat, 1.1 * every_val.s_hat);
+  EXPECT_EQ(third_val.unsolved, 0U);
+}
+
 }  // namespace
 }  // namespace selfsense::identification

@@ -57,6 +57,12 @@ struct OperatorStructure {
   std::vector<double> start{};
   bool fit_offset{true};
   std::size_t refinement_passes{2};  // output-error passes after the equation error (dead zones)
+  // The normal equations take every row_step-th sample (the operators still run through every
+  // sample), each weighted by row_step so that sums and residuals keep the units of every
+  // sample: on a long, oversampled record the least squares cost a fraction while the
+  // parameters' variance grows by the same factor, from far below the residual's (p / n).
+  // 1: every sample.
+  std::size_t row_step{1};
 };
 
 struct OperatorSignals {

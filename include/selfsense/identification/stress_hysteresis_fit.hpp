@@ -18,7 +18,8 @@ namespace selfsense::identification {
 // creep lags too (eigenvalues log-spaced like the sides' creep, operator_fit.hpp: fastest
 // min(100, 0.1 / Ts), slowest min(3 / duration, fastest / 2), on the play of threshold 0 and
 // creep_plays plays spread over the rest), each with its own weight in W0 and in W1; their
-// weights are free. Throws std::invalid_argument on mismatched or empty signals.
+// weights are free. row_step: the least squares take every row_step-th sample
+// (OperatorStructure::row_step). Throws std::invalid_argument on mismatched or empty signals.
 struct StressCreepSizes {
   std::size_t eigenvalues{0};      // creep lags per creep play; 0: no creep
   std::size_t creep_plays{0};      // creep plays besides threshold 0
@@ -28,6 +29,6 @@ struct StressCreepSizes {
 [[nodiscard]] models::StressHysteresisModel fit_stress_hysteresis(
     std::span<const double> e, std::span<const double> t, std::span<const double> d,
     std::span<const double> s, double sample_time, std::size_t plays,
-    const StressCreepSizes& creep = {});
+    const StressCreepSizes& creep = {}, std::size_t row_step = 1);
 
 }  // namespace selfsense::identification

@@ -41,6 +41,10 @@ struct IdentificationOptions {
   // The fitted side's remanent state at the first sample, when known (OperatorStructure::start;
   // not for stress-hysteresis): the diagnosis's trials of one recording take their null's.
   std::vector<double> start{};
+  // At most this many samples are rows of each least-squares fit: every m-th sample with
+  // m = ceil(n / max_rows), weighted by m (OperatorStructure::row_step), the operators still
+  // run through every sample. 0: every sample.
+  std::size_t max_rows{0};
 };
 inline constexpr std::array<std::size_t, 4> kBiasLevelCandidates{0, 1, 3, 7};
 inline constexpr std::array<std::size_t, 3> kStressPlayCandidates{16, 24, 48};
