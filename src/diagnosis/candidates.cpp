@@ -433,6 +433,7 @@ bool applicable(const Candidate& c, const ChannelData& ch, const Signals& s, boo
     return false;
   }
   if (uses(CorrectionTerm::kCreep) && ch.sensed && !ch.affine) return false;
+  if (c.generic && ch.loop_reidentified) return false;
   switch (c.needs) {
     case Needs::kTemperature:
       return range_of(s.temperature) > 1.0;

@@ -42,6 +42,10 @@ struct ChannelData {
   double coupling{0.0};                    // of the stress in the model's side
   std::span<const double> sensed_model{};  // the model's sensed response (electrostriction)
   bool affine{true};  // not the stress-hysteresis model: the response is G[x] + y0
+  // The diagnosis replaced the model by a structure identified on this record, its loop too
+  // (reidentified.hpp, reidentified_stress): a loop shape left over is that structure's own
+  // class, so the generic loop candidates are not tried on it.
+  bool loop_reidentified{false};
   // Shared by the channel's copies (the recording they read is the same).
   std::shared_ptr<FirstHalfFits> first_half{std::make_shared<FirstHalfFits>()};
 };

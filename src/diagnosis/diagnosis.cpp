@@ -98,6 +98,7 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
       static_cast<void>(hold_finite(ch.base));
       ch.coupling = 0.0;
       ch.affine = false;
+      ch.loop_reidentified = true;
       for (const Finding& f : stressed->named) {
         if (f.channel == ch.name) stress_found.push_back(f);
       }

@@ -72,21 +72,31 @@ class SideProblem {
 
   // W0 partial sums bounded below (the field dependence stays increasing), the rest free.
   [[nodiscard]] BoundedLeastSquaresSolution solve(const GramAccumulator& acc) const {
-    const auto p = static_cast<Eigen::Index>(basis_.columns());
-    const Eigen::Index cols = columns();
-    std::vector<bool> bounded(static_cast<std::size_t>(cols), false);
-    // The plays' weights (not the creep lags': a lag may move against its play).
-    std::fill_n(bounded.begin(), static_cast<Eigen::Index>(basis_.plays()), true);
-    const auto [y_lo, y_hi] = std::minmax_element(y_.begin(), y_.end());
-    const auto [e_lo, e_hi] = std::minmax_element(e_.begin(), e_.end());
-    Eigen::VectorXd lower = Eigen::VectorXd::Zero(cols);
-    lower.head(p).setConstant(1e-6 * (*y_hi - *y_lo) / (*e_hi - *e_lo));
-    return solve_bounded_least_squares(
-        {acc.gram(), acc.moment(), acc.output_energy(), bounded, lower});
+    return solve_bounded(acc.gram(), acc.moment(), acc.output_energy());
   }
 
-  [[nodiscard]] models::StressHysteresisSide fit(std::span<const double> history) const {
-    const BoundedLeastSquaresSolution sol = solve(gram(history, 0, e_.size()));
+  // The shaped loop change (LoopChange::kShaped): W1_i = W0_i (c0 + c1 x_i + c2 x_i^2) on the
+  // plays past the field's own, which is bilinear in W0 and c, so solved by alternating least
+  // squares from the free fit: with the last round's W0 as the reference W0ref, the parameters
+  // are linear, and the free problem's columns, combined by map(W0ref), give their Gram matrix
+  // without another pass over the samples.
+  [[nodiscard]] BoundedLeastSquaresSolution solve_shaped(const GramAccumulator& acc) const {
+    BoundedLeastSquaresSolution sol = solve(acc);
+    const Eigen::MatrixXd gram = acc.gram();
+    for (int round = 0; round < kShapedRounds; ++round) {
+      const Eigen::MatrixXd map = shaped_map(sol.theta);
+      sol = solve_bounded(map.transpose() * gram * map, map.transpose() * acc.moment(),
+                          acc.output_energy());
+      sol.theta = map * sol.theta;
+    }
+    return sol;
+  }
+
+  [[nodiscard]] models::StressHysteresisSide fit(std::span<const double> history,
+                                                 LoopChange loop_change) const {
+    const GramAccumulator acc = gram(history, 0, e_.size());
+    const BoundedLeastSquaresSolution sol =
+        loop_change == LoopChange::kShaped ? solve_shaped(acc) : solve(acc);
     const std::size_t p = basis_.columns();
     const Eigen::Index cols = columns();
     models::StressHysteresisSide side;
@@ -99,6 +109,54 @@ class SideProblem {
   }
 
  private:
+  // Alternations of the shaped fit. On four independent draws (stress_hysteresis_fit.hpp) one
+  // round and four gave the same validation nrmse within 3 %; the last round's W0 stays within
+  // 1 % of its reference (tests/identification/stress_optimum_test.cpp).
+  static constexpr int kShapedRounds = 3;
+
+  [[nodiscard]] BoundedLeastSquaresSolution solve_bounded(const Eigen::MatrixXd& gram,
+                                                          const Eigen::VectorXd& moment,
+                                                          double output_energy) const {
+    const auto p = static_cast<Eigen::Index>(basis_.columns());
+    std::vector<bool> bounded(static_cast<std::size_t>(gram.cols()), false);
+    // The plays' weights (not the creep lags': a lag may move against its play).
+    std::fill_n(bounded.begin(), static_cast<Eigen::Index>(basis_.plays()), true);
+    const auto [y_lo, y_hi] = std::minmax_element(y_.begin(), y_.end());
+    const auto [e_lo, e_hi] = std::minmax_element(e_.begin(), e_.end());
+    Eigen::VectorXd lower = Eigen::VectorXd::Zero(gram.cols());
+    lower.head(p).setConstant(1e-6 * (*y_hi - *y_lo) / (*e_hi - *e_lo));
+    return solve_bounded_least_squares({gram, moment, output_energy, bounded, lower});
+  }
+
+  // The free problem's columns as combinations of the shaped one's: W0 (the plays and lags) as
+  // it is, then W1 of the field's own play, c0..c2 (W1_i = W0ref_i (c0 + c1 x_i + c2 x_i^2), x_i
+  // the play's threshold mapped onto [-1, 1]), W1 of each lag, and d1, d2, the offset.
+  [[nodiscard]] Eigen::MatrixXd shaped_map(const Eigen::VectorXd& reference) const {
+    const auto p = static_cast<Eigen::Index>(basis_.columns());
+    const auto plays = static_cast<Eigen::Index>(basis_.plays());
+    const Eigen::Index lags = p - plays;
+    const Eigen::Index cols = columns();
+    const Eigen::Index reduced = p + 4 + lags + 3;
+    Eigen::MatrixXd map = Eigen::MatrixXd::Zero(cols, reduced);
+    for (Eigen::Index i = 0; i < p; ++i)
+      map(i, i) = 1.0;
+    map(p, p) = 1.0;
+    const std::vector<double>& r = basis_.thresholds;
+    const double first = plays > 1 ? r[1] : 0.0;
+    const double span = plays > 2 ? r.back() - first : 1.0;
+    for (Eigen::Index i = 1; i < plays; ++i) {
+      const double x = 2.0 * (r[static_cast<std::size_t>(i)] - first) / span - 1.0;
+      map(p + i, p + 1) = reference(i);
+      map(p + i, p + 2) = reference(i) * x;
+      map(p + i, p + 3) = reference(i) * x * x;
+    }
+    for (Eigen::Index j = 0; j < lags; ++j)
+      map(p + plays + j, p + 4 + j) = 1.0;
+    for (Eigen::Index j = 1; j <= 3; ++j)
+      map(cols - j, reduced - j) = 1.0;
+    return map;
+  }
+
   const operators::OperatorBasis& basis_;
   std::span<const double> e_, t_, y_;
   std::size_t row_step_;
@@ -141,7 +199,7 @@ std::vector<double> estimate_history(const SideProblem& problem, double sample_t
 models::StressHysteresisModel fit_stress_hysteresis(
     std::span<const double> e, std::span<const double> t, std::span<const double> d,
     std::span<const double> s, double sample_time, std::size_t plays, const StressCreepSizes& creep,
-    std::size_t row_step) {
+    std::size_t row_step, LoopChange loop_change) {
   const std::size_t n = e.size();
   if (n < 2 || t.size() != n || (!d.empty() && d.size() != n) || (!s.empty() && s.size() != n) ||
       (d.empty() && s.empty())) {
@@ -178,8 +236,8 @@ models::StressHysteresisModel fit_stress_hysteresis(
   const SideProblem reference(m.basis, e, t, d.empty() ? s : d, row_step);
   m.history =
       plays > 0 ? estimate_history(reference, sample_time, plays) : std::vector<double>{e.front()};
-  if (!d.empty()) m.sensor = SideProblem(m.basis, e, t, d, row_step).fit(m.history);
-  if (!s.empty()) m.actuator = SideProblem(m.basis, e, t, s, row_step).fit(m.history);
+  if (!d.empty()) m.sensor = SideProblem(m.basis, e, t, d, row_step).fit(m.history, loop_change);
+  if (!s.empty()) m.actuator = SideProblem(m.basis, e, t, s, row_step).fit(m.history, loop_change);
   const double span = *t_hi - *t_lo;
   m.stress_min = *t_lo - 0.1 * span;
   m.stress_max = *t_hi + 0.1 * span;

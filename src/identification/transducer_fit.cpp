@@ -117,7 +117,8 @@ OperatorModel fit_side(const OperatorSignals& s, OperatorStructure structure,
 // is not nested in that of m > n, and a denser grid matters (a generator off the grid: T_hat
 // 3.8 / 2.4 / 0.11 % on new data with 16 / 24 / 48 plays, docs/identification.md).
 std::size_t choose_stress_plays(const TransducerSignals& s, std::size_t fallback,
-                                const StressCreepSizes& creep, std::size_t row_step) {
+                                const StressCreepSizes& creep, std::size_t row_step,
+                                LoopChange loop_change) {
   const std::size_t n = s.drive.size();
   const std::size_t split = n - n / 4;
   const auto head = [split](std::span<const double> v) { return v.empty() ? v : v.first(split); };
@@ -134,7 +135,7 @@ std::size_t choose_stress_plays(const TransducerSignals& s, std::size_t fallback
   for (const std::size_t plays : kStressPlayCandidates) {
     const models::StressHysteresisModel m =
         fit_stress_hysteresis(head(s.drive), head(s.stress), head(s.sensed), head(s.strain),
-                              s.sample_time, plays, creep, row_step);
+                              s.sample_time, plays, creep, row_step, loop_change);
     double score = 0.0;
     if (m.sensor) {
       models::StressHysteresisReconstructor rec(m);
@@ -208,12 +209,13 @@ TransducerModel identify(const TransducerSignals& signals, Structure structure,
     const StressCreepSizes creep{options.eigenvalues, options.creep_plays,
                                  options.fastest_eigenvalue, options.slowest_eigenvalue};
     const std::size_t row_step = row_step_for(options, n);
-    const std::size_t plays = options.choose_plays && n >= 8
-                                  ? choose_stress_plays(signals, options.plays, creep, row_step)
-                                  : options.plays;
+    const std::size_t plays =
+        options.choose_plays && n >= 8
+            ? choose_stress_plays(signals, options.plays, creep, row_step, options.loop_change)
+            : options.plays;
     model.vectorial =
         fit_stress_hysteresis(signals.drive, signals.stress, signals.sensed, signals.strain,
-                              signals.sample_time, plays, creep, row_step);
+                              signals.sample_time, plays, creep, row_step, options.loop_change);
     return model;
   }
   std::vector<std::span<const double>> linear;

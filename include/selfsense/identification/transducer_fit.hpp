@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "selfsense/identification/stress_hysteresis_fit.hpp"
 #include "selfsense/models/transducer_model.hpp"
 
 namespace selfsense::identification {
@@ -38,6 +39,8 @@ struct IdentificationOptions {
   // kStressPlayCandidates on the fitting data alone: the reconstruction error (T_hat, and S_hat
   // with a strain channel) on the last quarter of a fit on the first three quarters.
   bool choose_plays{false};
+  // stress-hysteresis: how the stress changes the loop (stress_hysteresis_fit.hpp).
+  LoopChange loop_change{LoopChange::kShaped};
   // The fitted side's remanent state at the first sample, when known (OperatorStructure::start;
   // not for stress-hysteresis): the diagnosis's trials of one recording take their null's.
   std::vector<double> start{};
