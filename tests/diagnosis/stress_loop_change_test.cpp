@@ -25,13 +25,7 @@ namespace {
 using identification::LoopChange;
 
 diagnosis::Signals signals_of(const Recording& r) {
-  diagnosis::Signals s;
-  s.drive = r.e;
-  s.sensed = r.d;
-  s.stress = r.t;
-  s.strain = r.s;
-  s.sample_time = r.sample_time;
-  return s;
+  return {r.e, r.d, r.s, r.t, r.temp, r.sample_time};
 }
 
 struct Validation {

@@ -111,8 +111,9 @@ TEST(StressHysteresis, ReconstructsStressWhereTheAffineModelCannot) {
   const auto q_s = fit_quality(held(r.s), s_vec);
   std::printf("held out: T_hat %.3f %% (affine model %.2f %%), S_hat %.3f %%\n", 100 * q_vec.nrmse,
               100 * q_aff.nrmse, 100 * q_s.nrmse);
-  // Measured: T_hat 0.735 % (affine model 9.01 %), S_hat 0.395 % of range, held out; the bounds
-  // are about 1.2x, the affine model's 1.3x (docs/results.md).
+  // Measured: T_hat 0.711 % (affine model 9.01 %), S_hat 0.388 % of range, held out (0.735 and
+  // 0.395 % with a free loop change); the bounds are about 1.25x, the affine model's 1.3x
+  // (docs/results.md).
   EXPECT_LT(q_vec.nrmse, 0.009);
   EXPECT_LT(q_vec.nrmse, 0.2 * q_aff.nrmse);
   EXPECT_LT(q_aff.nrmse, 0.117);
@@ -147,14 +148,15 @@ TEST(StressHysteresis, CreepLagsAmongTheColumnsFollowTheCreepDuringHolds) {
   const auto [t_creep, s_creep] = held_out(creeping);
   std::printf("held out: T_hat %.3f %% -> %.3f %%, S_hat %.3f %% -> %.3f %% with creep lags\n",
               100 * t_plain, 100 * t_creep, 100 * s_plain, 100 * s_creep);
-  // Measured: T_hat 1.479 -> 1.410 %, S_hat 0.768 -> 0.735 %: the lags follow the creep of
+  // Measured: T_hat 1.412 -> 1.367 %, S_hat 0.720 -> 0.700 % (with a free loop change 1.479 ->
+  // 1.410 %, 0.768 -> 0.735 %): the lags follow the creep of
   // the field's response; the plant's creep also follows the stress's response, which no lag of
   // the field can (docs/identification.md). Deterministic, so the small gain is asserted as a
   // gain, and each figure within 1.1x.
   EXPECT_LT(t_creep, t_plain);
   EXPECT_LT(s_creep, s_plain);
-  EXPECT_LT(t_creep, 1.1 * 0.01410);
-  EXPECT_LT(s_creep, 1.1 * 0.00735);
+  EXPECT_LT(t_creep, 1.1 * 0.01367);
+  EXPECT_LT(s_creep, 1.1 * 0.00700);
 }
 
 // A model whose sensor side is D = a + b T + c T^2 with a = E (one linear play, weight 1) and
