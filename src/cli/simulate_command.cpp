@@ -22,13 +22,13 @@
 namespace selfsense::cli {
 
 using evaluation::AdaptedRuns;
-using evaluation::can_reconstruct;
 using evaluation::describe;
 using evaluation::field_signals;
 using evaluation::FieldSignals;
 using evaluation::ModelRuns;
 using evaluation::run_adapted;
 using evaluation::run_model;
+using models::can_reconstruct;
 namespace {
 
 struct RunOptions {

@@ -316,10 +316,7 @@ void check_model(const DaemonConfig& c, Problems& p) {
       p.add("model: " + c.model.string() + " is a " + std::string(models::to_string(m.structure)) +
             " model (charge drive); the drivers drive the field E and measure D");
     }
-    const bool sensor = m.vectorial ? m.vectorial->sensor.has_value()
-                                    : (m.sensor && !m.sensor->linear_gains.empty() &&
-                                       m.sensor->linear_gains.front() != 0.0);
-    if (!sensor) {
+    if (!models::can_reconstruct(m)) {
       p.add("model: " + c.model.string() +
             " cannot reconstruct stress (no sensor side with a stress coupling)");
     } else if (c.adaptation.enabled && c.adaptation.estimator.is_valid("", nullptr)) {

@@ -84,8 +84,15 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
   // The channels hold their own copies; the electrostriction term reads the sensed channel's
   // response to the drive alone (D - d T: the polarization and the dielectric part).
   static_cast<void>(hold_finite(outputs.sensed));
-  const std::vector<double> sensed_response =
-      response_to_drive(outputs.sensed, stressed ? 0.0 : coupling_of(model.sensor), s.stress);
+  // A channel whose side the stress-hysteresis structure took (a kept one runs as without it).
+  const auto replaced = [&](const ChannelData& ch) {
+    return stressed && stressed->replaces(ch.name);
+  };
+  const bool sensed_replaced =
+      std::any_of(channels.begin(), channels.end(),
+                  [&](const ChannelData& ch) { return ch.sensed && replaced(ch); });
+  const std::vector<double> sensed_response = response_to_drive(
+      outputs.sensed, sensed_replaced ? 0.0 : coupling_of(model.sensor), s.stress);
 
   const std::vector<Segment> drive_holds = holds_of(s.drive);
   for (ChannelData& ch : channels) {
@@ -93,7 +100,8 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
     ch.sensed_model = sensed_response;
     const std::vector<double> model_output = ch.base;  // for the figures before
     std::vector<Finding> stress_found;
-    if (stressed) {
+    const bool stress_side = replaced(ch);
+    if (stress_side) {
       ch.base = ch.sensed ? outputs.sensed : outputs.strain;
       static_cast<void>(hold_finite(ch.base));
       ch.coupling = 0.0;
@@ -137,18 +145,19 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
     };
     const auto accept_side = [&](const Reidentified& reid) {
       (ch.sensed ? result.improved.sensor : result.improved.actuator) = reid.side;
-      if (reid.structure) result.improved.structure = *reid.structure;
+      // A plain side kept beside the stress-hysteresis structure: the model keeps its structure.
+      if (reid.structure && !result.improved.vectorial) result.improved.structure = *reid.structure;
     };
     // A stack that warmed bends a base identified on it (its creep and loop follow the drift):
     // where the temperature moved, the channel's side is re-identified with the temperature's
     // terms, and if that forecasts better the rounds run on it.
     const std::optional<Reidentified> warmed =
-        stressed ? std::nullopt : reidentified_temperature(model, s, ch, model_output, options);
+        stress_side ? std::nullopt : reidentified_temperature(model, s, ch, model_output, options);
     if (warmed) accept_side(*warmed);
     std::vector<Finding> found;
     SearchState st = search(warmed, found);
     found.insert(found.begin(), stress_found.begin(), stress_found.end());
-    bool reidentified = warmed.has_value() || stressed.has_value();
+    bool reidentified = warmed.has_value() || stress_side;
     // The rounds again on a re-identified side; `kept` goes before what they find.
     const auto search_again = [&](const Reidentified& reid, std::vector<Finding> kept) {
       std::vector<Finding> again;
@@ -184,7 +193,7 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
     // channel where they name nothing but creep is judged for a leak too (the creep terms are
     // not re-identified there: the model has its creep operators already).
     const bool only_creep = !found.empty() && named_only("creep");
-    const bool leak_candidate = ch.sensed && !stressed &&
+    const bool leak_candidate = ch.sensed && !stress_side &&
                                 (found.empty() || creep_candidate || (!reidentified && only_creep));
     std::optional<Reidentified> creep =
         creep_candidate ? reidentified_creep(model, s, ch, model_output, options) : std::nullopt;
@@ -372,9 +381,9 @@ Result diagnose(const models::TransducerModel& model, const Signals& s, const Op
   if (!std::all_of(first.findings.begin(), first.findings.end(), stress_or_loop)) return first;
   // A loop and coupling that move with the stress bend an affine base: where nothing but the
   // stress (or the loop's generic shape beside it) is named, judged for the whole model (it
-  // replaces both sides) by re-identification with the stress-hysteresis structure (the
-  // corrections carry a coupling's change, not a loop that moves with T); then each channel's
-  // rounds run on it and no side is re-identified again.
+  // replaces every side it does not forecast worse) by re-identification with the
+  // stress-hysteresis structure (the corrections carry a coupling's change, not a loop that
+  // moves with T); then each channel's rounds run on it and no side is re-identified again.
   const std::optional<StressReidentified> stressed =
       reidentified_stress(model, s, channels, options);
   if (!stressed) return first;

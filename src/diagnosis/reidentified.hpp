@@ -24,9 +24,11 @@
 // Only the sensor side of field-drive models with one side per channel (not vectorial).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "candidates.hpp"
@@ -124,9 +126,11 @@ struct CreepAndLeak {
 // carries to new loads. The null is the model's structure identified on the first half of both
 // channels, the candidate `stress-hysteresis` (D or S = W0.q + T W1.q + d1 T + d2 T^2, the plays
 // of the field: loop and permittivity scaled by T, coupling quadratic in T) identified there too;
-// each channel where it forecasts the second half better by forecast_explains is named, and no
-// channel may forecast worse (the structure replaces both sides). The improved model is that
-// structure identified on the whole record. Nothing is judged where the stress does not move
+// each channel where it forecasts the second half better by forecast_explains is named. A
+// channel it forecasts worse keeps the model's own side (the plain side's dead zones and creep
+// can fit a channel without the effect better than the structure's plays), the others take the
+// structure's (models/stress_sides.hpp). The improved model is that structure identified on the
+// whole record, completed by the kept side. Nothing is judged where the stress does not move
 // apart from the field (a constant preload: what a fit on E and the base's outputs leaves of T is
 // below 1e-9 of its magnitude), and nothing is returned where the structure identified on the
 // whole record fits a channel worse than the given model; a named channel it fits by less than
@@ -137,6 +141,11 @@ struct StressReidentified {
   models::TransducerModel model{};  // stress-hysteresis, identified on the whole record
   Outputs outputs{};                // its D and S over the record
   std::vector<Finding> named{};     // one per channel where the forecast wins
+  std::vector<std::string> kept{};  // channels that keep the model's own side
+
+  [[nodiscard]] bool replaces(const std::string& channel) const {
+    return std::find(kept.begin(), kept.end(), channel) == kept.end();
+  }
 };
 
 [[nodiscard]] std::optional<StressReidentified> reidentified_stress(

@@ -218,8 +218,11 @@ std::optional<StressReidentified> reidentified_stress(const models::TransducerMo
     const double null_sse = sse_over(ch.recorded, a.unseen, rows.judge);
     const double stress_sse = sse_over(ch.recorded, b.unseen, rows.judge);
     if (!(null_sse > 0.0) || !(a.own_sse > 0.0)) return std::nullopt;
-    // The structure replaces both sides: no channel may forecast worse with it.
-    if (stress_sse > null_sse) return std::nullopt;
+    // A channel the structure forecasts worse keeps the model's side.
+    if (stress_sse > null_sse) {
+      r.kept.push_back(ch.name);
+      continue;
+    }
     // As forecast_explains: the identification's own evidence (both halves, each by the model
     // identified on it, fitted by min_explains better together), then the unseen halves by the
     // rules of a round with the halves as the unit of harm (forecasts_better).
@@ -237,6 +240,16 @@ std::optional<StressReidentified> reidentified_stress(const models::TransducerMo
   if (r.named.empty()) return std::nullopt;
   try {
     r.model = identified(s, Structure::kStressHysteresis, 0, n);
+    for (const ChannelData& ch : channels) {
+      if (r.replaces(ch.name)) continue;
+      if (ch.sensed) {
+        r.model.vectorial->sensor.reset();
+        r.model.sensor = model.sensor;
+      } else {
+        r.model.vectorial->actuator.reset();
+        r.model.actuator = model.actuator;
+      }
+    }
     r.outputs = simulate(r.model, s);
   } catch (const std::invalid_argument&) {
     return std::nullopt;
@@ -271,6 +284,10 @@ std::optional<StressReidentified> reidentified_stress(const models::TransducerMo
             "with %.0f %% less residual variance than the model's structure identified the "
             "same way: the model had bent its own operators to the stress)",
             100.0 * f.explains);
+    for (const std::string& other : r.kept) {
+      f.evidence += "; " + other +
+                    " keeps the model's own side, which forecasts it better than the structure";
+    }
     f.feature_name = "stress T [MPa]";
     f.feature = stress_mpa;
   }

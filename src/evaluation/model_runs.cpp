@@ -33,7 +33,7 @@ ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& si
     }
     runs.forward_counts = sim.counts();
   }
-  if (reconstruct && can_reconstruct(model) && !y.empty()) {
+  if (reconstruct && models::can_reconstruct(model) && !y.empty()) {
     models::Reconstruction rec(model, options);
     runs.rediscretised = rec.rediscretised();
     runs.stress_hat.resize(n);
@@ -49,12 +49,6 @@ ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& si
     runs.estimate_counts = rec.counts();
   }
   return runs;
-}
-
-bool can_reconstruct(const models::TransducerModel& model) {
-  if (model.vectorial) return model.vectorial->sensor.has_value();
-  return model.sensor && !model.sensor->linear_gains.empty() &&
-         model.sensor->linear_gains.front() != 0.0;
 }
 
 std::string describe(const models::StatusCounts& counts) {

@@ -260,12 +260,13 @@ TransducerModel read_model(YamlMap root) {
     model.sensed_range = read_range(*r, "sensed");
     r->finish();
   }
+  // A stress-hysteresis model may be completed by a plain side where its vectorial section has
+  // none (models/stress_sides.hpp).
   if (model.structure == Structure::kStressHysteresis) {
     model.vectorial = read_vectorial(root, model.sample_time);
-  } else {
-    model.sensor = read_side(root, "sensor", model.sample_time);
-    model.actuator = read_side(root, "actuator", model.sample_time);
   }
+  model.sensor = read_side(root, "sensor", model.sample_time);
+  model.actuator = read_side(root, "actuator", model.sample_time);
   if (auto c = root.optional_map("corrections")) {
     model.sensed_correction = read_correction(*c, "sensed");
     model.strain_correction = read_correction(*c, "strain");

@@ -235,17 +235,15 @@ SampleStatus InputGate::check(double first, double second) const noexcept {
 
 namespace {
 
-std::variant<Reconstructor, std::unique_ptr<StressHysteresisReconstructor>> make_reconstruction(
+std::variant<Reconstructor, std::unique_ptr<StressSidesReconstructor>> make_reconstruction(
     const TransducerModel& model) {
-  if (model.vectorial) {
-    return std::make_unique<StressHysteresisReconstructor>(*model.vectorial);
-  }
+  if (model.vectorial) return std::make_unique<StressSidesReconstructor>(model);
   return Reconstructor(model);
 }
 
-std::variant<ForwardModel, std::unique_ptr<StressHysteresisForward>> make_simulation(
+std::variant<ForwardModel, std::unique_ptr<StressSidesForward>> make_simulation(
     const TransducerModel& model) {
-  if (model.vectorial) return std::make_unique<StressHysteresisForward>(*model.vectorial);
+  if (model.vectorial) return std::make_unique<StressSidesForward>(model);
   return ForwardModel(model);
 }
 
@@ -266,16 +264,22 @@ Reconstruction::Reconstruction(const TransducerModel& model, const RuntimeOption
   if (model.sensed_correction && !model.sensed_correction->invertible("corrections.sensed", &why)) {
     throw std::invalid_argument(why);
   }
-  if (model.sensed_correction && model.vectorial) {
+  if (model.sensed_correction && model.vectorial && model.vectorial->sensor) {
+    // A stress-dependent sensor's response to the stress is not a coupling times T, so neither
+    // the response to the drive alone nor a solve of the stress through the correction exists
+    // (a plain sensor beside a stress-dependent actuator has both: plain_sensor_step).
     const auto& c = *model.sensed_correction;
-    const char* key = !c.creep_weights.empty()      ? "creep_weights"
-                      : c.stress_gain_per_pa != 0.0 ? "stress_gain_per_pa"
-                                                    : nullptr;
+    const char* key = !c.creep_weights.empty()            ? "creep_weights"
+                      : c.stress_gain_per_pa != 0.0       ? "stress_gain_per_pa"
+                      : c.stress_quadratic_per_pa2 != 0.0 ? "stress_quadratic_per_pa2"
+                      : c.stress_drive_per_pa != 0.0      ? "stress_drive_per_pa"
+                      : c.stress_linear_per_pa != 0.0     ? "stress_linear_per_pa"
+                                                          : nullptr;
     if (key != nullptr) {
       throw std::invalid_argument(
           std::string("corrections.sensed.") + key +
-          ": follows the sensor's response to the drive alone, which the stress-hysteresis "
-          "model does not separate");
+          ": follows the sensor's response to the drive alone or to the stress, which the "
+          "stress-hysteresis model does not separate");
     }
   }
   if (model.sensed_correction && sensed_coupling_ == 0.0) {
@@ -299,7 +303,7 @@ Reconstruction::Reconstruction(const TransducerModel& model, const RuntimeOption
 
 bool Reconstruction::has_strain() const noexcept {
   if (const auto* affine = std::get_if<Affine>(&impl_)) return affine->actuator().has_value();
-  return std::get<Vectorial>(impl_)->model().actuator.has_value();
+  return std::get<Vectorial>(impl_)->has_strain();
 }
 
 Reconstruction::Estimate Reconstruction::step(double drive, double sensed) noexcept {
@@ -307,30 +311,52 @@ Reconstruction::Estimate Reconstruction::step(double drive, double sensed) noexc
                     [this](double x, double y) { return kernel_step(x, y); });
 }
 
+// A stress-hysteresis strain part beside a plain sensor (stress_sides.hpp): as the affine
+// kernel, T_hat from the plain sensor with the sensed correction between the phases, then the
+// strain part at the corrected T_hat. x and y become the drive and sensed value as corrected.
+Reconstruction::Estimate Reconstruction::plain_sensor_step(StressSidesReconstructor& v, double& x,
+                                                           double& y) noexcept {
+  if (sensed_fix_) x = sensed_fix_->delay_drive(x);
+  const double response = v.sensed_response(x);
+  const double read = (sensed_fix_ && sensed_fix_->reads_response()) ? response : 0.0;
+  if (sensed_fix_) y = sensed_fix_->invert(y, {0.0, x, 0.0, temperature_, 0.0, read});
+  double stress = (y - response) / v.sensor_coupling();
+  if (sensed_fix_) {
+    stress =
+        sensed_fix_->solve_stress(stress, sensed_coupling_, {0.0, x, 0.0, temperature_, 0.0, read});
+  }
+  return {stress, v.strain_at(x, stress), SampleStatus::kOk};
+}
+
 Reconstruction::Estimate Reconstruction::kernel_step(double drive, double sensed) noexcept {
   double x = drive;
   double y = sensed;
-  auto* affine = std::get_if<Affine>(&impl_);
-  double response = 0.0;  // G_s[x] + y0_s, when the sensed correction's creep follows it
-  const bool split = sensed_fix_ && sensed_fix_->reads_response() && affine != nullptr;
-  if (sensed_fix_) {
-    x = sensed_fix_->delay_drive(drive);
-    if (split) response = affine->sensed_response(x);
-    y = sensed_fix_->invert(sensed, {0.0, x, 0.0, temperature_, 0.0, response});
-  }
   Estimate out{};
-  if (affine != nullptr) {
-    const Reconstructor::Estimate e = split ? affine->finish(x, y, response) : affine->step(x, y);
-    out = {e.stress, e.strain, SampleStatus::kOk};
+  auto* affine = std::get_if<Affine>(&impl_);
+  auto* vectorial = std::get_if<Vectorial>(&impl_);
+  if (vectorial != nullptr && (*vectorial)->plain_sensing()) {
+    out = plain_sensor_step(**vectorial, x, y);
   } else {
-    const StressHysteresisReconstructor::Estimate e = std::get<Vectorial>(impl_)->step(x, y);
-    out = {e.stress, e.strain, e.status};
-  }
-  if (sensed_fix_ && sensed_coupling_ != 0.0) {
-    const double stress = sensed_fix_->solve_stress(out.stress, sensed_coupling_,
-                                                    {0.0, x, 0.0, temperature_, 0.0, response});
-    out.strain += strain_coupling_ * (stress - out.stress);
-    out.stress = stress;
+    double response = 0.0;  // G_s[x] + y0_s, when the sensed correction's creep follows it
+    const bool split = sensed_fix_ && sensed_fix_->reads_response() && affine != nullptr;
+    if (sensed_fix_) {
+      x = sensed_fix_->delay_drive(drive);
+      if (split) response = affine->sensed_response(x);
+      y = sensed_fix_->invert(sensed, {0.0, x, 0.0, temperature_, 0.0, response});
+    }
+    if (affine != nullptr) {
+      const Reconstructor::Estimate e = split ? affine->finish(x, y, response) : affine->step(x, y);
+      out = {e.stress, e.strain, SampleStatus::kOk};
+    } else {
+      const StressSidesReconstructor::Estimate e = (*vectorial)->step(x, y);
+      out = {e.stress, e.strain, e.status};
+    }
+    if (sensed_fix_ && sensed_coupling_ != 0.0) {
+      const double stress = sensed_fix_->solve_stress(out.stress, sensed_coupling_,
+                                                      {0.0, x, 0.0, temperature_, 0.0, response});
+      out.strain += strain_coupling_ * (stress - out.stress);
+      out.stress = stress;
+    }
   }
   if (strain_fix_) {
     // The electrostriction term reads the sensed response to the drive alone, as forward.
@@ -361,7 +387,10 @@ void Reconstruction::memory(detail::ModelMemory& out) const noexcept {
     if (affine->sensor()) out.add(memory_of(affine->sensor()->op()));
     if (affine->actuator()) out.add(memory_of(affine->actuator()->op()));
   } else {
-    out.add(memory_of(std::get<Vectorial>(impl_)->stream()));
+    const StressSidesReconstructor& v = *std::get<Vectorial>(impl_);
+    out.add(memory_of(v.stream()));
+    if (const SideOperator* side = v.plain_sensor()) out.add(memory_of(side->op()));
+    if (const SideOperator* side = v.plain_actuator()) out.add(memory_of(side->op()));
   }
 }
 
@@ -372,7 +401,10 @@ void Reconstruction::adopt_state(const Reconstruction& running) noexcept {
     if (affine->sensor()) adopt_side(from, *affine->sensor(), scratch_);
     if (affine->actuator()) adopt_side(from, *affine->actuator(), scratch_);
   } else {
-    adopt_stream(from, std::get<Vectorial>(impl_)->stream(), scratch_);
+    StressSidesReconstructor& v = *std::get<Vectorial>(impl_);
+    adopt_stream(from, v.stream(), scratch_);
+    if (SideOperator* side = v.plain_sensor()) adopt_side(from, *side, scratch_);
+    if (SideOperator* side = v.plain_actuator()) adopt_side(from, *side, scratch_);
   }
   adopt_stage(sensed_fix_, running.sensed_fix_);
   adopt_stage(strain_fix_, running.strain_fix_);

@@ -3,6 +3,8 @@
 #include <array>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <tuple>
 #include <utility>
 
 #include "selfsense/operators/parameter_error.hpp"
@@ -91,7 +93,20 @@ bool TransducerModel::is_valid(std::string* why) const {
       if (why != nullptr) *why = "model: stress-hysteresis needs its vectorial section";
       return false;
     }
-    return vectorial->is_valid(why);
+    // Plain sides complete the vectorial model where it has none (stress_sides.hpp).
+    for (const auto& [name, plain, stressed] :
+         {std::tuple{"sensor", sensor.has_value(), vectorial->sensor.has_value()},
+          std::tuple{"actuator", actuator.has_value(), vectorial->actuator.has_value()}}) {
+      if (plain && stressed) {
+        if (why != nullptr) {
+          *why = std::string(name) +
+                 ": the vectorial section has this side already (a plain side only completes it)";
+        }
+        return false;
+      }
+    }
+    return vectorial->is_valid(why) && side_valid("sensor", sensor, sample_time, why) &&
+           side_valid("actuator", actuator, sample_time, why);
   }
   if (!sensor && !actuator) {
     if (why != nullptr) *why = "model: needs a sensor or an actuator side";
@@ -100,6 +115,12 @@ bool TransducerModel::is_valid(std::string* why) const {
   if (geometry && !geometry->is_valid(why)) return false;
   return side_valid("sensor", sensor, sample_time, why) &&
          side_valid("actuator", actuator, sample_time, why);
+}
+
+bool can_reconstruct(const TransducerModel& model) noexcept {
+  if (model.vectorial && model.vectorial->sensor) return true;
+  return model.sensor && !model.sensor->linear_gains.empty() &&
+         model.sensor->linear_gains.front() != 0.0;
 }
 
 }  // namespace selfsense::models

@@ -9,6 +9,7 @@
 
 #include "selfsense/identification/stress_hysteresis_fit.hpp"
 #include "selfsense/io/yaml_map.hpp"
+#include "selfsense/models/model_identity.hpp"
 #include "support/transducer_data.hpp"
 
 namespace selfsense::models {
@@ -85,6 +86,30 @@ TEST(ModelYaml, VectorialModelRoundTrips) {
   std::string broken = text;
   broken.replace(broken.find("stress_range: ["), 15, "stress_range: [1, ");
   expect_error(broken, "stress_range");
+}
+
+// Completed by a plain side where its vectorial section has none (models/stress_sides.hpp):
+// both come back, and a plain side where the vectorial section has one is refused by key.
+TEST(ModelYaml, VectorialModelCompletedByAPlainSideRoundTrips) {
+  const test::TransducerData d = test::transducer_data(test::typical_transducer(1e-3), 3000, 0, 4);
+  TransducerModel m;
+  m.structure = Structure::kStressHysteresis;
+  m.sample_time = 1e-3;
+  m.vectorial = fit_stress_hysteresis(d.e, d.t, d.d, d.s, 1e-3, 6);
+  m.vectorial->sensor.reset();
+  m.sensor = test::typical_transducer(1e-3).sensor;
+  const std::string text = model_to_string(m);
+  const TransducerModel back = model_from_string(text);
+  ASSERT_TRUE(back.vectorial.has_value());
+  EXPECT_FALSE(back.vectorial->sensor.has_value());
+  ASSERT_TRUE(back.sensor.has_value());
+  EXPECT_EQ(back.sensor->op.hysteresis.weights, m.sensor->op.hysteresis.weights);
+  EXPECT_EQ(parameter_hash(back), parameter_hash(m));
+  EXPECT_EQ(model_to_string(back), text);
+  TransducerModel twice = m;
+  twice.actuator = test::typical_transducer(1e-3).actuator;
+  std::string plain_actuator = model_to_string(twice);
+  expect_error(plain_actuator, "actuator: the vectorial section has this side already");
 }
 
 // With creep lags among its columns: the rows and eigenvalues come back, the gains follow from

@@ -32,7 +32,14 @@ std::vector<TransducerModel> every_runtime_structure(const test::TransducerData&
   vectorial.sample_time = ts;
   vectorial.vectorial = identification::fit_stress_hysteresis(d.e, d.t, d.d, d.s, ts, 12);
   vectorial.drive_range = affine.drive_range;
-  return {affine, vectorial};
+  // The stress structure on one channel, the plain side on the other (stress_sides.hpp).
+  TransducerModel stressed_sensor = vectorial;
+  stressed_sensor.vectorial->actuator.reset();
+  stressed_sensor.actuator = affine.actuator;
+  TransducerModel stressed_actuator = vectorial;
+  stressed_actuator.vectorial->sensor.reset();
+  stressed_actuator.sensor = affine.sensor;
+  return {affine, vectorial, stressed_sensor, stressed_actuator};
 }
 
 TEST(RuntimeModelRealTime, StepsStatesAndSwapsDoNotAllocate) {

@@ -34,8 +34,6 @@ struct ModelRuns {
 // temperature, where there is one, feeds the corrections' temperature terms.
 [[nodiscard]] ModelRuns run_model(const models::TransducerModel& model, const FieldSignals& signals,
                                   bool forward, bool reconstruct);
-// A sensor side with a stress coupling (or the stress-dependent model's sensor side).
-[[nodiscard]] bool can_reconstruct(const models::TransducerModel& model);
 // "ok 148199, input_out_of_range 1"
 [[nodiscard]] std::string describe(const models::StatusCounts& counts);
 [[nodiscard]] nlohmann::json to_json(const models::StatusCounts& counts);

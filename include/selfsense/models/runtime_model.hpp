@@ -49,6 +49,7 @@
 #include "selfsense/models/reconstructor.hpp"
 #include "selfsense/models/sample_status.hpp"
 #include "selfsense/models/stress_hysteresis.hpp"
+#include "selfsense/models/stress_sides.hpp"
 #include "selfsense/models/transducer_model.hpp"
 
 namespace selfsense::models {
@@ -123,10 +124,11 @@ class Reconstruction final {
 
  private:
   using Affine = Reconstructor;
-  using Vectorial = std::unique_ptr<StressHysteresisReconstructor>;
+  using Vectorial = std::unique_ptr<StressSidesReconstructor>;
 
   void memory(detail::ModelMemory& out) const noexcept;
   Estimate kernel_step(double drive, double sensed) noexcept;
+  Estimate plain_sensor_step(StressSidesReconstructor& v, double& x, double& y) noexcept;
 
   std::variant<Affine, Vectorial> impl_;
   detail::InputGate gate_{};
@@ -176,7 +178,7 @@ class Simulation final {
 
  private:
   using Affine = ForwardModel;
-  using Vectorial = std::unique_ptr<StressHysteresisForward>;
+  using Vectorial = std::unique_ptr<StressSidesForward>;
 
   Output kernel_step(double drive, double stress) noexcept;
 

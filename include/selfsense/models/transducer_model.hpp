@@ -88,4 +88,8 @@ struct TransducerModel {
   [[nodiscard]] bool is_valid(std::string* why) const;
 };
 
+// The model says something about the stress from the sensed channel: a stress-hysteresis sensor
+// side, or a plain sensor side with a non-zero stress coupling (Reconstruction needs one).
+[[nodiscard]] bool can_reconstruct(const TransducerModel& model) noexcept;
+
 }  // namespace selfsense::models

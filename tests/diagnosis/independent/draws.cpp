@@ -314,6 +314,11 @@ Outcome run_draw(std::uint64_t seed, Effect effect) {
   for (const diagnosis::Finding& f : result.findings) {
     o.findings.push_back({f.effect, f.channel});
   }
+  o.improved = std::string(models::to_string(result.improved.structure));
+  if (result.improved.vectorial) {
+    if (result.improved.sensor) o.improved += ", D plain";
+    if (result.improved.actuator) o.improved += ", S plain";
+  }
 
   const Recording val = record(o.draw, {.excitation = 1});
   const Recording val_clean = record(o.draw, {.excitation = 1, .effect = false});
@@ -341,7 +346,7 @@ std::string summary(const Outcome& o) {
       100 * o.s.before, 100 * o.s.after, 100 * o.s.clean, o.excess_ratio, o.pass ? "PASS" : "fail",
       o.seconds, o.seconds_diagnose));
   return std::string(buf.data()) + "\n    form: " + describe(o.draw) + "; expected [" +
-         names(o.expected) + "] (base " + o.structure + ")";
+         names(o.expected) + "] (base " + o.structure + "; improved " + o.improved + ")";
 }
 
 }  // namespace selfsense::independent

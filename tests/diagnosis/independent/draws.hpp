@@ -51,6 +51,9 @@ struct Outcome {
   std::vector<Named> expected{};
   std::string verdict{};
   std::vector<Named> findings{};
+  // The improved model's structure, with the channels whose plain side a stress-hysteresis
+  // model kept: "stress-hysteresis, D plain" (models/stress_sides.hpp).
+  std::string improved{};
   bool named_right{false};
   int extra_names{0};
   ChannelFigures d{};
