@@ -82,8 +82,8 @@ check() {  # check COLUMN LIMIT_PERCENT
 # period later), one line each. The device and the loop run on free-running clocks of one rate:
 # where their phases meet, a late poll reads one sample twice and misses the next. A missed
 # level on a ramp costs nothing; a missed reversal leaves the model's hysteresis memory short of
-# the plant's until a larger excursion wipes it out (measured: true S 0.184-0.790 % RMS over the
-# staircase with S_hat on the setpoint).
+# the plant's until a larger excursion wipes it out (traced in one run: true S 0.184 % RMS over
+# the staircase with S_hat on the setpoint).
 unseen_reversals() {
   awk -F, '
     /^#/ { next }
@@ -126,7 +126,7 @@ done
 # some 90 runs under load (one at 0.479 %, one at 0.184 %): in the 0.184 % run the loop read one
 # sample twice and missed the one after, which held the peak of E's overshoot on the first step
 # (commanded 944 727 V/m, read at most 932 881). Its hysteresis memory stayed short of the
-# plant's, and S_hat sat 1.1 % of the step above true S until the step to 9e-4 wiped it out.
+# plant's, and S_hat sat 1.1 % of its level above true S until the step to 9e-4 wiped it out.
 # Such a run is now done once more (unseen_reversals above). Seeing every sample of a polled
 # device needs the device's clock to pace the loop, or a buffer of samples on the device; neither
 # is built. (A descheduled device used to drop the periods it missed, which put its plant behind
