@@ -6,7 +6,9 @@
 # (scripts/main_job_report.sh, as in the main job). The run watches the loop's state as the
 # main job's do (scripts/daemon_runs.sh): a run that faults (a late wake-up on a shared machine
 # can make the sample stale) is reported and done again once; a second fault fails the test.
-# Then the device is killed: the loop faults
+# A staircase whose true S misses its limit after the loop missed a reversal of E (the device's
+# clock and the loop's, unseen_reversals below) is reported and run once more; a miss without
+# one, or a second miss, fails. Then the device is killed: the loop faults
 # (driver_timeout) and counts the errors; the device restarts on the same port: the driver
 # reconnects and the loop can be reset and armed again. SIGTERM ends both with status 0.
 #   modbus_end_to_end.sh BUILD_DIR
