@@ -419,17 +419,28 @@ void refine(const CorrectionSignals& s, std::span<const CorrectionTerm> terms,
 
 // The filters of a correction over a signal, into `out` (sized like x; reused between grid
 // points, so a search allocates its columns once).
-void filter_into(std::span<const double> x, const ChannelCorrection& filters, double ts,
-                 std::vector<double>& out) {
-  ChannelCorrection only;  // the filters without any term (a column is filtered, not corrected)
+// F[x] for each column x of `in`, into the matching `out` (resized): each column through its
+// own stage of the filters alone (a column is filtered, not corrected). The columns advance
+// together, sample by sample: each stage's recursion waits on its own last output, so the
+// stages' steps overlap in the processor (the same arithmetic as one column at a time).
+void filter_all(std::span<const std::span<const double>> in, const ChannelCorrection& filters,
+                double ts, std::span<std::vector<double>> out) {
+  ChannelCorrection only;  // the filters without any term
   only.dynamics_frequency_hz = filters.dynamics_frequency_hz;
   only.dynamics_damping = filters.dynamics_damping;
   only.leakage_tau_s = filters.leakage_tau_s;
   only.delay_s = filters.delay_s;
-  CorrectionStage stage(only, ts);
-  out.resize(x.size());
-  for (std::size_t k = 0; k < x.size(); ++k)
-    out[k] = stage.filter(x[k]);
+  const std::size_t n = in.empty() ? 0 : in.front().size();
+  std::vector<CorrectionStage> stages(in.size(), CorrectionStage(only, ts));
+  std::vector<double*> to(in.size());
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    out[i].resize(n);
+    to[i] = out[i].data();
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t i = 0; i < in.size(); ++i)
+      to[i][k] = stages[i].filter(in[i][k]);
+  }
 }
 
 struct Solved {
@@ -452,9 +463,18 @@ Normal zero_normal(Eigen::Index p) {
 void accumulate(Normal& n, std::span<const double> target,
                 std::span<const std::span<const double>> columns, std::size_t k,
                 Eigen::VectorXd& row) {
-  for (Eigen::Index i = 0; i < row.size(); ++i)
+  const Eigen::Index p = row.size();
+  for (Eigen::Index i = 0; i < p; ++i)
     row[i] = columns[static_cast<std::size_t>(i)][k];
-  n.g.selfadjointView<Eigen::Lower>().rankUpdate(row);
+  // G += row row' in the lower triangle, written out: Eigen's rank-one update costs more in
+  // its dispatch than in these few products (the same products and sums).
+  double* g = n.g.data();
+  for (Eigen::Index i = 0; i < p; ++i) {
+    const double v = row[i];
+    double* column = g + i * p;
+    for (Eigen::Index j = i; j < p; ++j)
+      column[j] += v * row[j];
+  }
   n.b += row * target[k];
   n.energy += target[k] * target[k];
 }
@@ -490,6 +510,19 @@ Solved solve_normal(Normal n) {
   out.sse = std::max(
       0.0, n.energy - 2.0 * out.coefficients.dot(n.b) + out.coefficients.dot(g * out.coefficients));
   return out;
+}
+
+// The fitting rows the least squares read (kCorrectionFitRows): every m-th of them.
+std::vector<bool> least_squares_rows(const std::vector<bool>& fit_rows) {
+  const auto count = static_cast<std::size_t>(std::count(fit_rows.begin(), fit_rows.end(), true));
+  if (count <= kCorrectionFitRows) return fit_rows;
+  const std::size_t step = (count + kCorrectionFitRows - 1) / kCorrectionFitRows;
+  std::vector<bool> kept(fit_rows.size(), false);
+  std::size_t seen = 0;
+  for (std::size_t k = 0; k < fit_rows.size(); ++k) {
+    if (fit_rows[k] && seen++ % step == 0) kept[k] = true;
+  }
+  return kept;
 }
 
 Solved solve(std::span<const double> target, std::span<const std::span<const double>> columns,
@@ -528,19 +561,19 @@ void fill_regressors(const CorrectionSignals& s, const Columns& columns,
   r.columns.clear();
   r.columns.reserve(columns.phi.size());
   if (any_filter) {
-    r.owned.resize(columns.phi.size() + 1);  // the last one: F[y]
-    for (std::size_t i = 0; i < columns.phi.size(); ++i) {
-      filter_into(columns.phi[i], filters, s.sample_time, r.owned[i]);
+    std::vector<std::span<const double>> in(columns.phi.begin(), columns.phi.end());
+    in.emplace_back(s.y);
+    r.owned.resize(in.size());  // the last one: F[y]
+    filter_all(in, filters, s.sample_time, r.owned);
+    for (std::size_t i = 0; i < columns.phi.size(); ++i)
       r.columns.emplace_back(r.owned[i]);
-    }
   } else {
     for (const std::vector<double>& phi : columns.phi)
       r.columns.emplace_back(phi);
   }
   r.target.assign(s.recorded.begin(), s.recorded.end());
   if (any_filter) {
-    std::vector<double>& fy = r.owned.back();
-    filter_into(s.y, filters, s.sample_time, fy);
+    const std::vector<double>& fy = r.owned.back();
     for (std::size_t k = 0; k < n; ++k)
       r.target[k] -= fy[k];
   } else {
@@ -607,12 +640,13 @@ CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const Correct
   check_signals(s, fit_rows);
   const std::size_t n = s.y.size();
   const Columns columns = make_columns(s, terms);
+  const std::vector<bool> solved_rows = least_squares_rows(fit_rows);
   Solved best;
   ChannelCorrection best_filters;
   Regressors work;  // the columns of each setting tried, in buffers allocated once
   const auto evaluate = [&](const ChannelCorrection& filters) {
     fill_regressors(s, columns, filters, work);
-    Solved solved = solve(work.target, work.columns, fit_rows);
+    Solved solved = solve(work.target, work.columns, solved_rows);
     if (solved.sse < best.sse) {
       best = std::move(solved);
       best_filters = filters;
@@ -658,8 +692,9 @@ std::vector<std::vector<double>> held_out_outputs(const CorrectionSignals& s,
   Normal all = zero_normal(p);
   std::vector<Normal> of_fold(folds, zero_normal(p));
   Eigen::VectorXd row(p);
+  const std::vector<bool> solved_rows = least_squares_rows(fit_rows);
   for (std::size_t k = 0; k < n; ++k) {
-    if (!fit_rows[k]) continue;
+    if (!solved_rows[k]) continue;
     const int f = fold[k];
     if (f >= 0 && static_cast<std::size_t>(f) < folds) {
       accumulate(of_fold[static_cast<std::size_t>(f)], r.target, r.columns, k, row);

@@ -46,27 +46,32 @@ BoundedLeastSquaresSolution solve(const GramAccumulator& acc, const Bounds& boun
 struct RowStep {
   std::size_t step{1};
   [[nodiscard]] bool keeps(std::size_t k) const { return k % step == 0; }
+  [[nodiscard]] std::size_t next_kept(std::size_t k) const { return (k + step - 1) / step * step; }
   [[nodiscard]] double weight() const { return std::sqrt(static_cast<double>(step)); }
 };
 
-// Streams rows over samples [from, count) (the operator still runs from sample 0 through
-// every sample): fill(k, phi, row, target) writes one row, given the operator columns phi of
-// sample k.
+// Streams rows over the kept samples of [from, count) (the operator's state still follows every
+// sample from 0, RegressorStream::skip between rows): fill(k, phi, row, target) writes one row,
+// given the operator columns phi of sample k.
 template <typename Fill>
 GramAccumulator accumulate(const OperatorBasis& basis, std::span<const double> x,
                            std::span<const double> history, std::size_t count, Eigen::Index cols,
                            RowStep rows, Fill fill, std::size_t from = 0) {
   GramAccumulator acc(cols);
   RegressorStream stream(basis, history);
-  for (std::size_t k = 0; k < from && k < count; ++k)
-    static_cast<void>(stream.next(x[k]));
   RowBlock block(kBlockRows, cols);
   Eigen::VectorXd target(kBlockRows);
   Eigen::Index row = 0;
   const double weight = rows.weight();
-  for (std::size_t k = from; k < count; ++k) {
+  stream.skip(x.first(std::min(from, count)));
+  for (std::size_t k = std::min(from, count); k < count; ++k) {
+    const std::size_t kept = rows.next_kept(k);  // the samples before it only advance the state
+    if (kept > k) {
+      stream.skip(x.subspan(k, std::min(kept, count) - k));
+      k = kept;
+      if (k >= count) break;
+    }
     const std::span<const double> phi = stream.next(x[k]);
-    if (!rows.keeps(k)) continue;
     fill(k, phi, std::span<double>(block.row(row).data(), static_cast<std::size_t>(cols)),
          target(row));
     if (rows.step > 1) {
@@ -89,6 +94,10 @@ struct Fit {
   std::vector<double> gains{};
   double offset{0.0};
   double rss{std::numeric_limits<double>::infinity()};  // output error on the fitted samples
+  // v = theta . phi over the fitted samples, kept by the fitter that scored this fit (empty
+  // when not yet computed): a refit of S alone needs no operator pass, and the refit of theta
+  // after it starts from it.
+  std::vector<double> inner{};
 };
 
 class Fitter {
@@ -155,13 +164,13 @@ class Fitter {
     Fit fit = from;
     fit.theta = sol.theta.head(static_cast<Eigen::Index>(ops));
     fit.shape = DeadZoneSuperposition(dz.superposition(slopes)).inverse().params();
-    fit.rss = output_rss(fit);
+    score(fit);
     return fit;
   }
 
   // Output error for S, g and offset with theta fixed (linear in them given v = theta . phi).
   [[nodiscard]] Fit refit_shape(const Fit& from) const {
-    const std::vector<double> inner = unloaded_inner(from);
+    std::vector<double> inner = inner_of(from);
     DeadZoneBasis dz{from.shape.upper_thresholds, from.shape.lower_thresholds};
     const std::size_t shape_cols = dz.columns();
     const auto cols = static_cast<Eigen::Index>(shape_cols + extras());
@@ -195,7 +204,8 @@ class Fitter {
     std::vector<double> slopes(sol.theta.data(), sol.theta.data() + shape_cols);
     fit.shape = dz.superposition(slopes);
     unpack_extras(sol.theta, shape_cols, fit);
-    fit.rss = output_rss(fit);
+    fit.inner = std::move(inner);  // theta unchanged
+    fit.rss = output_rss(fit, fit.inner);
     return fit;
   }
 
@@ -203,7 +213,7 @@ class Fitter {
   // v0 = theta0 . phi, S(v) = S(v0) + S'(v0) (v - v0) exactly while v stays on its segment.
   [[nodiscard]] Fit refit_operator(const Fit& from) const {
     const DeadZoneSuperposition shape(from.shape);
-    const std::vector<double> v0 = unloaded_inner(from);
+    const std::vector<double> v0 = inner_of(from);
     const std::size_t ops = basis_.columns();
     const auto cols = static_cast<Eigen::Index>(ops + extras());
     const GramAccumulator acc =
@@ -219,7 +229,7 @@ class Fitter {
     Fit fit = from;
     fit.theta = sol.theta.head(static_cast<Eigen::Index>(ops));
     unpack_extras(sol.theta, ops, fit);
-    fit.rss = output_rss(fit);
+    score(fit);
     return fit;
   }
 
@@ -274,9 +284,19 @@ class Fitter {
     return v;
   }
 
-  [[nodiscard]] double output_rss(const Fit& fit) const {
+  // fit.inner when this fitter computed it, else v of fit's theta afresh.
+  [[nodiscard]] std::vector<double> inner_of(const Fit& fit) const {
+    return fit.inner.empty() ? unloaded_inner(fit) : fit.inner;
+  }
+
+  // v of fit's theta, and the output error through its S.
+  void score(Fit& fit) const {
+    fit.inner = unloaded_inner(fit);
+    fit.rss = output_rss(fit, fit.inner);
+  }
+
+  [[nodiscard]] double output_rss(const Fit& fit, std::span<const double> v) const {
     const DeadZoneSuperposition shape(fit.shape);
-    const std::vector<double> v = unloaded_inner(fit);
     double rss = 0.0;
     for (std::size_t k = 0; k < v.size(); ++k) {
       double y = shape.evaluate(v[k]) + fit.offset;
@@ -519,9 +539,11 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
   std::vector<double> history{signals.input.front()};
   if (!structure.start.empty()) history = structure.start;
   if (search) {
+    const RowStep scored{ranking_row_step(rows.step)};
+    const Fitter start_fitter(signals, basis, weight_floor, structure.fit_offset, scored);
     history =
-        best_start(fitter, signals.input,
-                   start_finalists(signals, basis, weight_floor, structure.fit_offset, rows, {}));
+        best_start(start_fitter, signals.input,
+                   start_finalists(signals, basis, weight_floor, structure.fit_offset, scored, {}));
   }
   Fit fit = fit_with_history(fitter, history, structure, n);
   if (basis.hinges() > 0 && structure.dead_zones > 0) {
@@ -535,6 +557,7 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
     Fit candidate = fit_with_history(plain_fitter, history, structure, n);
     candidate.theta.conservativeResize(static_cast<Eigen::Index>(basis.columns()));
     candidate.theta.tail(static_cast<Eigen::Index>(basis.hinges())).setZero();
+    candidate.inner.clear();  // the hinges' zeros change the dot product's rounding
     if (candidate.rss < fit.rss) fit = candidate;
     for (std::size_t pass = 0; pass < structure.refinement_passes; ++pass) {
       candidate = fitter.refit_operator(candidate);
@@ -550,10 +573,11 @@ OperatorModel fit_operator(const OperatorSignals& signals, const OperatorStructu
     // operator is linear, and keep the better fit.
     const std::vector<double> v = inner_output(signals, fit);
     const OperatorSignals inner{signals.input, {}, v, signals.sample_time};
-    const Fitter inner_fitter(inner, basis, weight_floor, true, rows);
+    const RowStep scored{ranking_row_step(rows.step)};
+    const Fitter inner_fitter(inner, basis, weight_floor, true, scored);
     std::vector<double> second =
         best_start(inner_fitter, signals.input,
-                   start_finalists(inner, basis, weight_floor, true, rows, history));
+                   start_finalists(inner, basis, weight_floor, true, scored, history));
     if (second != history) {
       Fit refit = fit_with_history(fitter, second, structure, n);
       if (refit.rss < fit.rss) {

@@ -47,8 +47,14 @@ class SideProblem {
     Eigen::Index row = 0;
     const double weight = std::sqrt(static_cast<double>(row_step_));
     for (std::size_t k = 0; k < to; ++k) {
+      // The samples before the next row only advance the state (RegressorStream::skip).
+      const std::size_t kept = (std::max(k, from) + row_step_ - 1) / row_step_ * row_step_;
+      if (kept > k) {
+        stream.skip(e_.subspan(k, std::min(kept, to) - k));
+        k = kept;
+        if (k >= to) break;
+      }
       const std::span<const double> q = stream.next(e_[k]);
-      if (k < from || k % row_step_ != 0) continue;
       for (std::size_t i = 0; i < p; ++i) {
         block(row, static_cast<Eigen::Index>(i)) = q[i];
         block(row, static_cast<Eigen::Index>(p + i)) = t_[k] * q[i];
@@ -232,8 +238,9 @@ models::StressHysteresisModel fit_stress_hysteresis(
       m.basis.creep_rows.push_back(k * (plays + 1) / (extra + 1));
     m = models::with_creep_gains(std::move(m));
   }
-  // The history shows most clearly in the sensed channel (larger loops, exact charge).
-  const SideProblem reference(m.basis, e, t, d.empty() ? s : d, row_step);
+  // The history shows most clearly in the sensed channel (larger loops, exact charge). Its
+  // candidates are ranked (ranking_row_step).
+  const SideProblem reference(m.basis, e, t, d.empty() ? s : d, ranking_row_step(row_step));
   m.history =
       plays > 0 ? estimate_history(reference, sample_time, plays) : std::vector<double>{e.front()};
   if (!d.empty()) m.sensor = SideProblem(m.basis, e, t, d, row_step).fit(m.history, loop_change);

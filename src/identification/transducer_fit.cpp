@@ -135,7 +135,7 @@ std::size_t choose_stress_plays(const TransducerSignals& s, std::size_t fallback
   for (const std::size_t plays : kStressPlayCandidates) {
     const models::StressHysteresisModel m =
         fit_stress_hysteresis(head(s.drive), head(s.stress), head(s.sensed), head(s.strain),
-                              s.sample_time, plays, creep, row_step, loop_change);
+                              s.sample_time, plays, creep, ranking_row_step(row_step), loop_change);
     double score = 0.0;
     if (m.sensor) {
       models::StressHysteresisReconstructor rec(m);

@@ -10,6 +10,7 @@ namespace selfsense::operators {
 RegressorStream::RegressorStream(const OperatorBasis& basis, std::span<const double> history)
     : basis_(&basis),
       plays_(basis.plays(), history.empty() ? 0.0 : history.front()),
+      spare_(basis.plays()),
       lags_(basis.creep()),
       row_(basis.columns()) {
   for (const double h : history)
@@ -23,11 +24,24 @@ RegressorStream::RegressorStream(const OperatorBasis& basis, std::span<const dou
 
 std::span<const double> RegressorStream::next(double x) noexcept {
   const OperatorBasis& b = *basis_;
-  kernels::play_bank_step(x, b.thresholds, plays_);
+  // The plays step into the spare buffer, and each difference clamps its two plays from the
+  // old state again: reading back plays just stored, unaligned, stalled the loop on store
+  // forwarding (a fifth of this function's time in `selfsense diagnose`). The same arithmetic.
   const std::size_t n = plays_.size();
-  for (std::size_t i = 0; i + 1 < n; ++i)
-    row_[i] = plays_[i] - plays_[i + 1];
-  row_[n - 1] = plays_[n - 1];
+  const double* r = b.thresholds.data();
+  const double* old = plays_.data();
+  double* stepped = spare_.data();
+  const auto clamp = [x, r, old](std::size_t i) {
+    return std::min(std::max(old[i], x - r[i]), x + r[i]);
+  };
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    const double p = clamp(i);
+    stepped[i] = p;
+    row_[i] = p - clamp(i + 1);
+  }
+  stepped[n - 1] = clamp(n - 1);
+  row_[n - 1] = stepped[n - 1];
+  plays_.swap(spare_);
   const std::size_t n_eig = b.eigenvalues.size();
   std::size_t c = n;
   for (std::size_t i = 0; i < b.creep_rows.size(); ++i) {
@@ -41,6 +55,21 @@ std::span<const double> RegressorStream::next(double x) noexcept {
   for (std::size_t h = 0; h < b.hinge_rows.size(); ++h)
     row_[c++] = std::max(plays_[b.hinge_rows[h]] - b.hinge_levels[h], 0.0);
   return row_;
+}
+
+void RegressorStream::skip(std::span<const double> xs) noexcept {
+  const OperatorBasis& b = *basis_;
+  const std::size_t n_eig = b.eigenvalues.size();
+  for (const double x : xs) {
+    kernels::play_bank_step(x, b.thresholds, plays_);
+    for (std::size_t i = 0; i < b.creep_rows.size(); ++i) {
+      const double p = plays_[b.creep_rows[i]];
+      for (std::size_t j = 0; j < n_eig; ++j) {
+        double& z = lags_[i * n_eig + j];
+        z += b.gains[j] * (p - z);
+      }
+    }
+  }
 }
 
 void RegressorStream::save_state(std::span<double> out) const noexcept {

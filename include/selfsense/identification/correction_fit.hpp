@@ -57,6 +57,15 @@ struct CorrectionFit {
   double fit_sse{0.0};           // sum of squared errors on the fitting rows
 };
 
+// The least squares of a correction read at most this many of its fitting rows: every m-th
+// of more, m = ceil(rows / kCorrectionFitRows); the filters and the corrected output still run
+// over every sample, and fit_sse counts every fitting row. A correction has at most some 20
+// coefficients, so 2e5 rows leave their variance below 1e-4 of the residual's, and the normal
+// equations of a 1e6-sample record's rounds cost two fifths (docs/diagnose.md, "Speed"). Fits
+// on up to 2e5 rows (every recording of up to 4e5 samples judged on half its blocks, the
+// independent draws') are as before.
+inline constexpr std::size_t kCorrectionFitRows = 200000;
+
 // Fits the given terms; `start` carries filter parameters already chosen (they are kept, not
 // searched again) and is otherwise ignored. fit_rows[k]: sample k may be used for fitting.
 // Throws std::invalid_argument on mismatched sizes, no fitting rows, no finite fit, or a fit

@@ -65,6 +65,18 @@ struct OperatorStructure {
   std::size_t row_step{1};
 };
 
+// The row step of a ranking among candidates (the remanent state's histories, the stress
+// structure's play counts) on a fit of row step `fitted`. A record within the caller's row
+// budget (1) ranks them on every sample, as it is fitted. A longer one ranks them on every 4th
+// fitted row: a ranking reads the systematic misfit of some 30-100 columns, which a quarter of
+// up to 2e5 rows still resolves, and on a 1e6-sample record the rankings cost half of
+// `selfsense diagnose` (docs/diagnose.md, "Speed"). The winner is then fitted on every fitted
+// row.
+[[nodiscard]] constexpr std::size_t ranking_row_step(std::size_t fitted) noexcept {
+  constexpr std::size_t kThinning = 4;
+  return fitted > 1 ? fitted * kThinning : 1;
+}
+
 struct OperatorSignals {
   std::span<const double> input{};                       // x
   std::vector<std::span<const double>> linear_inputs{};  // u_k

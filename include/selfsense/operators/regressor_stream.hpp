@@ -37,6 +37,9 @@ class RegressorStream {
   RegressorStream(const OperatorBasis& basis, std::span<const double> history);
   // Advances with input x; the returned view is valid until the next call. Real-time safe.
   std::span<const double> next(double x) noexcept;
+  // Advances through the inputs xs to the state next() on each would leave, bit for bit,
+  // without forming their rows (a fit that reads every m-th row). Real-time safe.
+  void skip(std::span<const double> xs) noexcept;
 
   [[nodiscard]] const OperatorBasis& basis() const noexcept { return *basis_; }
   [[nodiscard]] std::span<const double> plays() const noexcept { return plays_; }
@@ -50,6 +53,7 @@ class RegressorStream {
  private:
   const OperatorBasis* basis_;
   std::vector<double> plays_{};
+  std::vector<double> spare_{};  // the plays' next state, swapped in
   std::vector<double> lags_{};
   std::vector<double> row_{};
 };
