@@ -13,6 +13,16 @@
 // the side identified on it forecast two fast damped modes of the independent draws worse than
 // a delay did: 2400003 and 2400008, traced on development draws). Not causal: the
 // whole record at once, the ends held (w[-1] = w[-2] = w[0], y[n] = y[n-1]).
+//
+// Then v is kept to the mode's band: a second-order Butterworth low-pass at f0, forward and
+// backward (zero phase, |L|^2 = 1 / (1 + (f / f0)^4)). Above the mode the recorded strain is the
+// mode's tail, falling as (f0 / f)^2 under sensor noise that the inverse lifts by (f / f0)^2;
+// the low-pass's (f0 / f)^4 cancels that lift, so the record undone holds the strain of the
+// band and not the noise above it. A side is identified on it and forecast through the mode,
+// which removes that band again. Without it, a side identified on a mode undone well below
+// Nyquist had taken in the lifted noise: on the development draws (900000-900029) the modes'
+// validation excess fell with it (900003 0.45 -> 0.04x, 900011 0.33 -> 0.02x, 900024 0.20 ->
+// 0.02x, none worse; docs/diagnose.md, "A mode undone within its band").
 #pragma once
 
 #include <span>
