@@ -417,12 +417,11 @@ void refine(const CorrectionSignals& s, std::span<const CorrectionTerm> terms,
   }
 }
 
-// The filters of a correction over a signal, into `out` (sized like x; reused between grid
-// points, so a search allocates its columns once).
-// F[x] for each column x of `in`, into the matching `out` (resized): each column through its
-// own stage of the filters alone (a column is filtered, not corrected). The columns advance
-// together, sample by sample: each stage's recursion waits on its own last output, so the
-// stages' steps overlap in the processor (the same arithmetic as one column at a time).
+// F[x] for each column x of `in`, into the matching `out` (resized; reused between grid points,
+// so a search allocates its columns once): each column through its own stage of the filters
+// alone (a column is filtered, not corrected). The columns advance together, sample by sample:
+// each stage's recursion waits on its own last output, so the stages' steps overlap in the
+// processor (the same arithmetic as one column at a time).
 void filter_all(std::span<const std::span<const double>> in, const ChannelCorrection& filters,
                 double ts, std::span<std::vector<double>> out) {
   ChannelCorrection only;  // the filters without any term
