@@ -42,32 +42,30 @@ std::span<const double> RegressorStream::next(double x) noexcept {
   stepped[n - 1] = clamp(n - 1);
   row_[n - 1] = stepped[n - 1];
   plays_.swap(spare_);
-  const std::size_t n_eig = b.eigenvalues.size();
-  std::size_t c = n;
-  for (std::size_t i = 0; i < b.creep_rows.size(); ++i) {
-    const double p = plays_[b.creep_rows[i]];
-    for (std::size_t j = 0; j < n_eig; ++j) {
-      double& z = lags_[i * n_eig + j];
-      z += b.gains[j] * (p - z);
-      row_[c++] = z;
-    }
-  }
+  step_lags();
+  std::copy(lags_.begin(), lags_.end(), row_.begin() + static_cast<std::ptrdiff_t>(n));
+  std::size_t c = n + lags_.size();
   for (std::size_t h = 0; h < b.hinge_rows.size(); ++h)
     row_[c++] = std::max(plays_[b.hinge_rows[h]] - b.hinge_levels[h], 0.0);
   return row_;
 }
 
 void RegressorStream::skip(std::span<const double> xs) noexcept {
+  for (const double x : xs) {
+    kernels::play_bank_step(x, basis_->thresholds, plays_);
+    step_lags();
+  }
+}
+
+// z_rj += a_j (p_r - z_rj) from the plays just stepped.
+void RegressorStream::step_lags() noexcept {
   const OperatorBasis& b = *basis_;
   const std::size_t n_eig = b.eigenvalues.size();
-  for (const double x : xs) {
-    kernels::play_bank_step(x, b.thresholds, plays_);
-    for (std::size_t i = 0; i < b.creep_rows.size(); ++i) {
-      const double p = plays_[b.creep_rows[i]];
-      for (std::size_t j = 0; j < n_eig; ++j) {
-        double& z = lags_[i * n_eig + j];
-        z += b.gains[j] * (p - z);
-      }
+  for (std::size_t i = 0; i < b.creep_rows.size(); ++i) {
+    const double p = plays_[b.creep_rows[i]];
+    for (std::size_t j = 0; j < n_eig; ++j) {
+      double& z = lags_[i * n_eig + j];
+      z += b.gains[j] * (p - z);
     }
   }
 }

@@ -32,7 +32,7 @@ std::vector<double> input() {
   for (double& v : x)
     v = std::round(v / 0.05) * 0.05;
   for (std::size_t k = 0; k < 300; ++k)
-    x.push_back(x.back() + 0.01);  // one long rise: every sample inside it is skipped
+    x.push_back(x.back() + 0.01);  // one long rise
   return x;
 }
 

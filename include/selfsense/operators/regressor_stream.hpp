@@ -51,6 +51,8 @@ class RegressorStream {
   void restore_state(std::span<const double> in) noexcept;
 
  private:
+  void step_lags() noexcept;
+
   const OperatorBasis* basis_;
   std::vector<double> plays_{};
   std::vector<double> spare_{};  // the plays' next state, swapped in
