@@ -90,7 +90,7 @@ void describe_dynamics(Finding& f, const Evidence& e) {
   // sampling lag it (Butterworth 0.71, Bessel 0.87), not a mechanical mode: named a delay. Its
   // lag is the stage's filter's at DC (bilinear, prewarped at f0): zeta Ts / tan(w0 Ts / 2),
   // 2 zeta / w0 well below Nyquist.
-  if (c.dynamics_damping >= kNoResonanceDamping) {
+  if (c.dynamics_damping >= kNoResonanceDamping && c.dynamics2_frequency_hz == 0.0) {
     const double omega = 2.0 * std::numbers::pi * c.dynamics_frequency_hz;
     const double lag_s = c.dynamics_damping * s.sample_time / std::tan(omega * s.sample_time / 2.0);
     f.effect = "delay";
@@ -102,13 +102,28 @@ void describe_dynamics(Finding& f, const Evidence& e) {
                  format("through a low-pass (second order, %.4g Hz, damping %.2g)",
                         c.dynamics_frequency_hz, c.dynamics_damping) +
                  tail;
-  } else {
+  } else if (c.dynamics2_frequency_hz > 0.0) {
+    const double first = 1.0 - c.dynamics_direct - c.dynamics2_share;
     f.evidence = "the recorded " + n +
                  format(
-                     " rings and lags at fast changes like a resonance at %.4g Hz with %.2g "
-                     "damping (inertia of stack and load)",
-                     c.dynamics_frequency_hz, c.dynamics_damping) +
+                     " rings and lags at fast changes like two resonances, at %.4g Hz with %.2g "
+                     "damping (share %.2g)",
+                     c.dynamics_frequency_hz, c.dynamics_damping, first) +
+                 format(" and at %.4g Hz with %.2g damping (share %.2g)", c.dynamics2_frequency_hz,
+                        c.dynamics2_damping, c.dynamics2_share) +
+                 format(", %.2g of it passing neither (inertia of stack and load, two modes)",
+                        c.dynamics_direct) +
                  tail;
+  } else {
+    f.evidence =
+        "the recorded " + n +
+        format(
+            " rings and lags at fast changes like a resonance at %.4g Hz with %.2g "
+            "damping (inertia of stack and load)",
+            c.dynamics_frequency_hz, c.dynamics_damping) +
+        (c.dynamics_direct != 0.0 ? format(", %.2g of it passing the mode by", c.dynamics_direct)
+                                  : std::string()) +
+        tail;
   }
   f.feature_name = "rate of the drive [1/s]";
   f.feature = rate_of(s.drive, s.sample_time);
@@ -311,6 +326,16 @@ const std::vector<Candidate>& candidates() {
        &describe_leakage},
       {"delay", {CorrectionTerm::kDelay}, true, true, Needs::kNothing, &describe_delay},
       {"dynamics", {CorrectionTerm::kDynamics}, false, true, Needs::kNothing, &describe_dynamics},
+      // Two modes in parallel (a stack and its load, or a mount), and the share of the strain
+      // that passes neither: the one-mode form's mode kept, the second searched beside it.
+      {"dynamics",
+       {CorrectionTerm::kDynamics, CorrectionTerm::kSecondMode},
+       false,
+       true,
+       Needs::kNothing,
+       &describe_dynamics,
+       false,
+       true},
       // On the sensed channel the lags follow its response to the drive alone (D - d T), which
       // the reconstruction knows before the measurement (affine models).
       {"creep",
@@ -507,7 +532,8 @@ bool searches_filter(const Candidate& c, const ChannelCorrection& accepted) {
   for (const CorrectionTerm t : c.terms) {
     if ((t == CorrectionTerm::kLeakage && accepted.leakage_tau_s == 0.0) ||
         (t == CorrectionTerm::kDelay && accepted.delay_s == 0.0) ||
-        (t == CorrectionTerm::kDynamics && accepted.dynamics_frequency_hz == 0.0)) {
+        (t == CorrectionTerm::kDynamics && accepted.dynamics_frequency_hz == 0.0) ||
+        (t == CorrectionTerm::kSecondMode && accepted.dynamics2_frequency_hz == 0.0)) {
       return true;
     }
   }
@@ -529,6 +555,7 @@ std::size_t complexity(const std::vector<CorrectionTerm>& terms) {
         break;
       case CorrectionTerm::kTemperature:  // gain, offset, drive, stress (each per K or K^2)
       case CorrectionTerm::kTemperatureQuadratic:
+      case CorrectionTerm::kSecondMode:  // f2, zeta2 and the two shares
         n += 4;
         break;
       case CorrectionTerm::kCreep:

@@ -52,6 +52,10 @@ struct Candidate {
   // The hysteresis operators bend to many residuals (a static curve, a slow drift under a
   // periodic drive): chosen only when no specific physics explains the residual significantly.
   bool generic{false};
+  // A richer form of the candidate listed just before it (two modes beside one): tried only
+  // where that one explains enough on the held-out blocks to be named in the same round, its
+  // search starting from that one's filters (the first mode kept); not tried on one stretch.
+  bool extends_previous{false};
 };
 
 [[nodiscard]] const std::vector<Candidate>& candidates();

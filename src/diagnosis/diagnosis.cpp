@@ -258,7 +258,7 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
       const LagSeen seen =
           st.lag_explains >= options.min_explains ? LagSeen::kInRounds : LagSeen::kNo;
       std::optional<Reidentified> late =
-          reidentified_lag(model, s, ch, model_output, options, st.lag_mode, seen);
+          reidentified_lag(model, s, ch, model_output, options, st.lag_mode, seen, st.named_modes);
       if (late) search_again(*late, {});
     }
     result.findings.insert(result.findings.end(), std::make_move_iterator(found.begin()),

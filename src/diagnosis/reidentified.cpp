@@ -39,7 +39,7 @@ class Judge {
   [[nodiscard]] std::vector<double> undone(const models::ChannelCorrection& effect) const {
     const std::span<const double> x = ch_.recorded;
     if (effect.dynamics_frequency_hz > 0.0) {
-      return mode_undone(x, effect.dynamics_frequency_hz, effect.dynamics_damping, s_.sample_time);
+      return modes_undone(x, effect, s_.sample_time);
     }
     std::vector<double> out(x.begin(), x.end());
     if (effect.empty()) return out;
@@ -490,7 +490,8 @@ std::optional<Reidentified> reidentified_lag(const models::TransducerModel& mode
                                              const std::vector<double>& current,
                                              const Options& options,
                                              const models::ChannelCorrection& mode_seed,
-                                             LagSeen seen) {
+                                             LagSeen seen,
+                                             const models::ChannelCorrection& named_modes) {
   if (!reidentifiable(model, s, ch)) return std::nullopt;
   const Judge judge(model, s, ch);
   const double most = static_cast<double>(models::kMaxCorrectionDelaySamples) * s.sample_time;
@@ -567,6 +568,11 @@ std::optional<Reidentified> reidentified_lag(const models::TransducerModel& mode
       return out;
     };
     Trial best_mode = best_of(judge, modes, mode_neighbours, null.start);
+    if (named_modes.dynamics_frequency_hz > 0.0) {
+      // The rounds' two modes (or mode and direct path) as they were fitted, undone together.
+      Trial block = in_full(judge, judge.trial(named_modes, null.start));
+      if (block.first_half_sse < best_mode.first_half_sse) best_mode = std::move(block);
+    }
     if (!best_mode.forecast.empty() &&
         best.first_half_sse > options.parsimony_ratio * best_mode.first_half_sse) {
       best = std::move(best_mode);
@@ -575,9 +581,13 @@ std::optional<Reidentified> reidentified_lag(const models::TransducerModel& mode
   }
   std::optional<Reidentified> r = judged(judge, ch, null, best, options, ShownBy::kFitAndForecast);
   if (!r) return std::nullopt;
-  const CorrectionTerm term = mode ? CorrectionTerm::kDynamics : CorrectionTerm::kDelay;
+  const bool two =
+      mode && (best.effect.dynamics2_frequency_hz > 0.0 || best.effect.dynamics_direct != 0.0);
+  const CorrectionTerm term = !mode ? CorrectionTerm::kDelay
+                              : two ? CorrectionTerm::kSecondMode
+                                    : CorrectionTerm::kDynamics;
   r->candidate = &candidate_using(term);
-  r->terms = {term};
+  r->terms = r->candidate->terms;
   r->finding.effect = r->candidate->effect;
   r->finding.where = where_it_changes(r->output, current);
   describe(r->finding, *r->candidate, r->correction, ch, s, current, r->output,

@@ -194,7 +194,8 @@ enum class LagSeen { kInRounds, kNo };
 [[nodiscard]] std::optional<Reidentified> reidentified_lag(
     const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
     const std::vector<double>& current, const Options& options,
-    const models::ChannelCorrection& mode_seed = {}, LagSeen seen = LagSeen::kInRounds);
+    const models::ChannelCorrection& mode_seed = {}, LagSeen seen = LagSeen::kInRounds,
+    const models::ChannelCorrection& named_modes = {});
 
 }  // namespace selfsense::diagnosis::detail
 

@@ -9,6 +9,38 @@
 #include "text.hpp"
 
 namespace selfsense::diagnosis::detail {
+namespace {
+
+// The filters a fit `found` chose, into `start` where it has none of its own (so a refit keeps
+// them, not searching again): the longer leak and delay, the modes.
+void take_filters(ChannelCorrection& start, const ChannelCorrection& found) {
+  start.leakage_tau_s = std::max(start.leakage_tau_s, found.leakage_tau_s);
+  start.delay_s = std::max(start.delay_s, found.delay_s);
+  if (start.dynamics_frequency_hz == 0.0) {
+    start.dynamics_frequency_hz = found.dynamics_frequency_hz;
+    start.dynamics_damping = found.dynamics_damping;
+  }
+  if (start.dynamics2_frequency_hz == 0.0) {
+    start.dynamics2_frequency_hz = found.dynamics2_frequency_hz;
+    start.dynamics2_damping = found.dynamics2_damping;
+  }
+}
+
+// Where the accepted correction has two modes or a direct path, its dynamics block.
+void keep_named_modes(SearchState& st) {
+  const ChannelCorrection& c = st.accepted;
+  if (c.dynamics2_frequency_hz == 0.0 && c.dynamics_direct == 0.0) return;
+  ChannelCorrection block;
+  block.dynamics_frequency_hz = c.dynamics_frequency_hz;
+  block.dynamics_damping = c.dynamics_damping;
+  block.dynamics_direct = c.dynamics_direct;
+  block.dynamics2_frequency_hz = c.dynamics2_frequency_hz;
+  block.dynamics2_damping = c.dynamics2_damping;
+  block.dynamics2_share = c.dynamics2_share;
+  st.named_modes = block;
+}
+
+}  // namespace
 
 void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>& findings) {
   for (std::size_t round = 0; round < in.options.max_effects && st.current_sse > 0.0; ++round) {
@@ -24,26 +56,40 @@ void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>&
       bool in_pool{false};
     };
     std::vector<Tried> tried;
+    // What any candidate must explain to be named: min_explains of what is left, min_share of
+    // what the model left.
+    const auto large_enough = [&](const Tried& t) {
+      return t.explains >= in.options.min_explains &&
+             t.explains * st.current_sse >= in.options.min_share * st.original_sse;
+    };
     for (const Candidate& c : candidates()) {
       if (named_already(st.used, c)) continue;
       if (!applicable(c, in.ch, in.s, in.has_sensor, in.charge_drive)) continue;
       const std::vector<CorrectionTerm> terms = merged(st.accepted_terms, c.terms);
       ChannelCorrection start = st.accepted;
+      ChannelCorrection seed;  // filters chosen before this candidate's own search
+      if (c.extends_previous) {
+        // Tried where the candidate before it (its simpler form) is significant on the held-out
+        // blocks this round, from that candidate's filters.
+        const Candidate* simpler = &c - 1;
+        const auto previous = std::find_if(tried.begin(), tried.end(),
+                                           [&](const Tried& t) { return t.candidate == simpler; });
+        if (previous == tried.end() || !large_enough(*previous) ||
+            !passes_blocks(previous->blocks, in.options)) {
+          continue;
+        }
+        take_filters(seed, previous->fit.correction);
+        take_filters(start, seed);
+      }
       try {
-        if (searches_filter(c, st.accepted) && !st.accepted_terms.empty()) {
+        if (searches_filter(c, start) && !st.accepted_terms.empty()) {
           // Search the new filter's parameters on what the st.accepted terms leave (few columns),
           // then refit every coefficient jointly with the filters fixed.
           identification::CorrectionSignals on_current = in.cs;
           on_current.y = st.current;
           const ChannelCorrection found =
-              identification::fit_correction(on_current, c.terms, ChannelCorrection{}, in.rows.fit)
-                  .correction;
-          start.leakage_tau_s = std::max(start.leakage_tau_s, found.leakage_tau_s);
-          start.delay_s = std::max(start.delay_s, found.delay_s);
-          if (start.dynamics_frequency_hz == 0.0) {
-            start.dynamics_frequency_hz = found.dynamics_frequency_hz;
-            start.dynamics_damping = found.dynamics_damping;
-          }
+              identification::fit_correction(on_current, c.terms, seed, in.rows.fit).correction;
+          take_filters(start, found);
         }
         identification::CorrectionFit fit =
             identification::fit_correction(in.cs, terms, start, in.rows.fit);
@@ -85,10 +131,7 @@ void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>&
     // The held-out holds judge a hysteresis operator only when it would be named or listed
     // (each judgement costs a fit).
     const auto significant = [&](Tried& t) {
-      if (t.explains < in.options.min_explains ||
-          t.explains * st.current_sse < in.options.min_share * st.original_sse) {
-        return false;
-      }
+      if (!large_enough(t)) return false;
       const bool in_blocks = passes_blocks(t.blocks, in.options);
       if (!t.candidate->generic) return in_blocks || creep_passes_on_holds(t.holds, in.options);
       if (!in_blocks) return false;
@@ -164,6 +207,7 @@ void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>&
 
     st.accepted_terms = merged(st.accepted_terms, best.candidate->terms);
     st.accepted = best.fit.correction;
+    keep_named_modes(st);
     st.used.push_back(best.candidate);
     ++st.rounds_named;
     st.current = best.fit.output;
@@ -201,10 +245,16 @@ void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& fi
       // A hysteresis operator fitted to one stretch would bend to anything in it: transients
       // are named by specific physics only.
       if (c.generic) continue;
+      // A richer form only beside its simpler one where that is the best so far, from its
+      // filters (the information criterion then weighs the parameters it adds).
+      ChannelCorrection seed;
+      if (c.extends_previous) {
+        if (best != &c - 1) continue;
+        take_filters(seed, best_found);
+      }
       identification::CorrectionFit local;
       try {
-        local =
-            identification::fit_correction(on_current, c.terms, ChannelCorrection{}, in_segment);
+        local = identification::fit_correction(on_current, c.terms, seed, in_segment);
       } catch (const std::invalid_argument&) {
         continue;  // no finite fit in this stretch
       }
@@ -220,12 +270,7 @@ void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& fi
     }
     if (best == nullptr) continue;
     ChannelCorrection start = st.accepted;
-    start.leakage_tau_s = std::max(start.leakage_tau_s, best_found.leakage_tau_s);
-    start.delay_s = std::max(start.delay_s, best_found.delay_s);
-    if (start.dynamics_frequency_hz == 0.0) {
-      start.dynamics_frequency_hz = best_found.dynamics_frequency_hz;
-      start.dynamics_damping = best_found.dynamics_damping;
-    }
+    take_filters(start, best_found);
     const std::vector<CorrectionTerm> terms = merged(st.accepted_terms, best->terms);
     identification::CorrectionFit joint;
     try {
@@ -253,6 +298,7 @@ void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& fi
     st.used.push_back(best);
     st.accepted_terms = terms;
     st.accepted = joint.correction;
+    keep_named_modes(st);
     st.current = joint.output;
     st.current_sse = sse_over(in.ch.recorded, st.current, in.rows.judge);
   }
@@ -283,7 +329,9 @@ void absorbed_pass(const SearchInput& in, SearchState& st, std::vector<Finding>&
   };
   std::vector<Passed> passed;
   for (const Candidate& c : candidates()) {
-    if (c.generic || !applicable(c, in.ch, in.s, in.has_sensor, in.charge_drive)) continue;
+    // Each in its simplest form: a richer one is tried in the rounds, beside its simpler one.
+    if (c.generic || c.extends_previous) continue;
+    if (!applicable(c, in.ch, in.s, in.has_sensor, in.charge_drive)) continue;
     std::vector<CorrectionTerm> terms = merged(own, c.terms);
     try {
       ChannelCorrection start;

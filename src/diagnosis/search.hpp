@@ -39,6 +39,9 @@ struct SearchState {
   // The mode (frequency and damping) of the first round's dynamics candidate, fitted or not: the
   // seed of the modes tried beside the delay.
   ChannelCorrection lag_mode{};
+  // The dynamics block of a named correction with two modes or a direct path (the filters
+  // alone): tried as it is beside the modes around lag_mode when the lag is re-identified.
+  ChannelCorrection named_modes{};
 };
 
 // Rounds of candidates until none is significant (or options.max_effects): findings appended.

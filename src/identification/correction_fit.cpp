@@ -25,6 +25,7 @@ struct Columns {
   std::vector<double> hinge_thresholds{};
   std::vector<double> hinge_levels{};
   bool stress_varies{false};  // the temperature terms carry their stress columns
+  bool mode_shares{false};    // kSecondMode: the mode shares' columns follow phi (filters)
 };
 
 constexpr std::size_t kCorrectionPlays = 8;
@@ -215,6 +216,9 @@ Columns make_columns(const CorrectionSignals& s, std::span<const CorrectionTerm>
         }
         break;
       }
+      case CorrectionTerm::kSecondMode:
+        c.mode_shares = has_term(terms, CorrectionTerm::kDynamics);
+        break;  // its columns depend on the filters (fill_regressors)
       case CorrectionTerm::kDynamics:
       case CorrectionTerm::kLeakage:
       case CorrectionTerm::kDelay:
@@ -305,6 +309,18 @@ void apply_coefficients(std::span<const CorrectionTerm> terms, const Columns& co
   }
 }
 
+// A mode's grid: 8 frequencies per decade from 1/500 of Nyquist (10 cycles of the record at
+// least) to 0.8 Nyquist, each at 7 dampings.
+std::vector<std::pair<double, double>> mode_grid(double ts, double duration) {
+  const double nyquist = 0.5 / ts;
+  std::vector<std::pair<double, double>> out;
+  for (const double f : log_spaced(std::max(nyquist / 500.0, 10.0 / duration), 0.8 * nyquist, 8)) {
+    for (const double zeta : {0.01, 0.02, 0.04, 0.08, 0.15, 0.3, 0.6})
+      out.emplace_back(f, zeta);
+  }
+  return out;
+}
+
 // The filter settings to try: the given ones, or a grid for each searched filter.
 std::vector<ChannelCorrection> filter_grid(const CorrectionSignals& s,
                                            std::span<const CorrectionTerm> terms,
@@ -315,6 +331,10 @@ std::vector<ChannelCorrection> filter_grid(const CorrectionSignals& s,
   ChannelCorrection fixed;
   fixed.dynamics_frequency_hz = start.dynamics_frequency_hz;
   fixed.dynamics_damping = start.dynamics_damping;
+  if (has(CorrectionTerm::kSecondMode)) {
+    fixed.dynamics2_frequency_hz = start.dynamics2_frequency_hz;
+    fixed.dynamics2_damping = start.dynamics2_damping;
+  }
   fixed.leakage_tau_s = start.leakage_tau_s;
   fixed.delay_s = start.delay_s;
   std::vector<ChannelCorrection> grid{fixed};
@@ -348,23 +368,34 @@ std::vector<ChannelCorrection> filter_grid(const CorrectionSignals& s,
     expand([](ChannelCorrection& c, double v) { c.delay_s = v; }, delays);
   }
   if (has(CorrectionTerm::kDynamics) && start.dynamics_frequency_hz == 0.0) {
-    const double nyquist = 0.5 / ts;
-    const std::vector<double> f0 =
-        log_spaced(std::max(nyquist / 500.0, 10.0 / duration), 0.8 * nyquist, 8);
     std::vector<ChannelCorrection> next;
     for (const ChannelCorrection& g : grid) {
-      for (const double f : f0) {
-        for (const double zeta : {0.01, 0.02, 0.04, 0.08, 0.15, 0.3, 0.6}) {
-          ChannelCorrection c = g;
-          c.dynamics_frequency_hz = f;
-          c.dynamics_damping = zeta;
-          next.push_back(c);
-        }
+      for (const auto& [f, zeta] : mode_grid(ts, duration)) {
+        ChannelCorrection c = g;
+        c.dynamics_frequency_hz = f;
+        c.dynamics_damping = zeta;
+        next.push_back(c);
       }
     }
     grid = std::move(next);
   }
   return grid;
+}
+
+// The second mode's settings to try beside the chosen filters (the first mode fixed): the
+// first's grid, less its own frequency.
+std::vector<ChannelCorrection> second_mode_grid(const CorrectionSignals& s,
+                                                const ChannelCorrection& chosen) {
+  std::vector<ChannelCorrection> out;
+  const double duration = static_cast<double>(s.y.size()) * s.sample_time;
+  for (const auto& [f, zeta] : mode_grid(s.sample_time, duration)) {
+    if (std::abs(std::log(f / chosen.dynamics_frequency_hz)) < 0.05) continue;
+    ChannelCorrection c = chosen;
+    c.dynamics2_frequency_hz = f;
+    c.dynamics2_damping = zeta;
+    out.push_back(c);
+  }
+  return out;
 }
 
 // Coordinate search around the best grid point of every searched filter parameter: each is
@@ -385,6 +416,12 @@ void refine(const CorrectionSignals& s, std::span<const CorrectionTerm> terms,
   if (has(CorrectionTerm::kDynamics) && start.dynamics_frequency_hz == 0.0) {
     params.push_back(&ChannelCorrection::dynamics_frequency_hz);
     params.push_back(&ChannelCorrection::dynamics_damping);
+  }
+  // The second mode once it is chosen (second_mode_grid), jointly with the rest.
+  if (has(CorrectionTerm::kSecondMode) && start.dynamics2_frequency_hz == 0.0 &&
+      best.dynamics2_frequency_hz > 0.0) {
+    params.push_back(&ChannelCorrection::dynamics2_frequency_hz);
+    params.push_back(&ChannelCorrection::dynamics2_damping);
   }
   if (params.empty()) return;
   ChannelCorrection current = best;
@@ -430,11 +467,38 @@ void filter_all(std::span<const std::span<const double>> in, const ChannelCorrec
   only.leakage_tau_s = filters.leakage_tau_s;
   only.delay_s = filters.delay_s;
   const std::size_t n = in.empty() ? 0 : in.front().size();
-  std::vector<CorrectionStage> stages(in.size(), CorrectionStage(only, ts));
+  std::vector<CorrectionStage> stages(in.size(), CorrectionStage(only, ts));  // checks `only`
   std::vector<double*> to(in.size());
   for (std::size_t i = 0; i < in.size(); ++i) {
     out[i].resize(n);
     to[i] = out[i].data();
+  }
+  if (n > 0 && only.dynamics_frequency_hz > 0.0 && only.leakage_tau_s == 0.0 &&
+      only.delay_s == 0.0) {
+    // A mode alone: the stage's recursion written out where it inlines (a mode's search filters
+    // the record once per setting tried), in the stage's order of operations: the same doubles.
+    const models::ModeCoefficients m =
+        models::mode_coefficients(only.dynamics_frequency_hz, only.dynamics_damping, ts);
+    const double b1 = 2.0 * m.b0;
+    for (std::size_t i = 0; i < in.size(); ++i) {
+      const std::span<const double> x = in[i];
+      double* y = to[i];
+      double v1 = x[0];
+      double v2 = x[0];
+      double w1 = x[0];
+      double w2 = x[0];
+      y[0] = x[0];
+      for (std::size_t k = 1; k < n; ++k) {
+        const double v = x[k];
+        const double w = m.b0 * v + b1 * v1 + m.b0 * v2 - m.a1 * w1 - m.a2 * w2;
+        v2 = v1;
+        v1 = v;
+        w2 = w1;
+        w1 = w;
+        y[k] = w;
+      }
+    }
+    return;
   }
   for (std::size_t k = 0; k < n; ++k) {
     for (std::size_t i = 0; i < in.size(); ++i)
@@ -537,7 +601,8 @@ Solved solve(std::span<const double> target, std::span<const std::span<const dou
 
 // The regressors of a fit with the given filters: the columns (filtered when there are filters)
 // and the target recorded - F[y]. `columns` views `owned` (or the unfiltered columns): a move
-// keeps those views valid, a copy would not, so there is none.
+// keeps those views valid, a copy would not, so there is none. With mode shares the last
+// columns are R[y] - F[y] (a direct path) and, with a second mode, F2[y] - F[y].
 struct Regressors {
   Regressors() = default;
   Regressors(const Regressors&) = delete;
@@ -547,37 +612,79 @@ struct Regressors {
   ~Regressors() = default;
 
   std::vector<std::vector<double>> owned{};
+  std::vector<std::vector<double>> shares{};  // R[y] - F[y], F2[y] - F[y]
   std::vector<std::span<const double>> columns{};
   std::vector<double> target{};
+  // The filters `owned` and `target` were computed for (the second mode's search changes only
+  // F2, so it reuses them); none yet when empty.
+  std::vector<ChannelCorrection> filled_for{};
 };
+
+// The filters without a second mode: what F and R depend on.
+ChannelCorrection first_filters(const ChannelCorrection& filters) {
+  ChannelCorrection c;
+  c.dynamics_frequency_hz = filters.dynamics_frequency_hz;
+  c.dynamics_damping = filters.dynamics_damping;
+  c.leakage_tau_s = filters.leakage_tau_s;
+  c.delay_s = filters.delay_s;
+  return c;
+}
+
+void filter_one(std::span<const double> in, const ChannelCorrection& filters, double ts,
+                std::vector<double>& out) {
+  const std::span<const double> one[] = {in};
+  filter_all(one, filters, ts, std::span<std::vector<double>>(&out, 1));
+}
 
 // Fills `r` for these filters, reusing its buffers (a filter search evaluates many settings).
 void fill_regressors(const CorrectionSignals& s, const Columns& columns,
                      const ChannelCorrection& filters, Regressors& r) {
   // Unfiltered columns are read in place (a 1e6-sample recording: no copies per evaluation).
-  const bool any_filter = !filters.empty();
+  const ChannelCorrection first = first_filters(filters);
+  const bool any_filter = !first.empty();
+  const bool shares = columns.mode_shares && filters.dynamics_frequency_hz > 0.0;
   const std::size_t n = s.y.size();
-  r.columns.clear();
-  r.columns.reserve(columns.phi.size());
-  if (any_filter) {
-    std::vector<std::span<const double>> in(columns.phi.begin(), columns.phi.end());
-    in.emplace_back(s.y);
-    r.owned.resize(in.size());  // the last one: F[y]
-    filter_all(in, filters, s.sample_time, r.owned);
-    for (std::size_t i = 0; i < columns.phi.size(); ++i)
-      r.columns.emplace_back(r.owned[i]);
-  } else {
-    for (const std::vector<double>& phi : columns.phi)
-      r.columns.emplace_back(phi);
-  }
-  r.target.assign(s.recorded.begin(), s.recorded.end());
-  if (any_filter) {
-    const std::vector<double>& fy = r.owned.back();
+  const bool reuse = !r.filled_for.empty() && r.filled_for.front() == first;
+  if (!reuse) {
+    r.filled_for.clear();  // until the filters below have run (they may throw)
+    if (any_filter) {
+      std::vector<std::span<const double>> in(columns.phi.begin(), columns.phi.end());
+      in.emplace_back(s.y);
+      r.owned.resize(in.size());  // the last one: F[y]
+      filter_all(in, first, s.sample_time, r.owned);
+    }
+    r.target.assign(s.recorded.begin(), s.recorded.end());
+    const std::span<const double> fy = any_filter ? std::span<const double>(r.owned.back()) : s.y;
     for (std::size_t k = 0; k < n; ++k)
       r.target[k] -= fy[k];
-  } else {
+    if (shares) {
+      r.shares.resize(2);
+      ChannelCorrection rest = first;
+      rest.dynamics_frequency_hz = 0.0;
+      rest.dynamics_damping = 0.0;
+      filter_one(s.y, rest, s.sample_time, r.shares[0]);
+      for (std::size_t k = 0; k < n; ++k)
+        r.shares[0][k] -= fy[k];
+    }
+    r.filled_for.assign(1, first);
+  }
+  r.columns.clear();
+  r.columns.reserve(columns.phi.size() + 2);
+  for (std::size_t i = 0; i < columns.phi.size(); ++i) {
+    r.columns.emplace_back(any_filter ? std::span<const double>(r.owned[i])
+                                      : std::span<const double>(columns.phi[i]));
+  }
+  if (!shares) return;
+  r.columns.emplace_back(r.shares[0]);
+  if (filters.dynamics2_frequency_hz > 0.0) {
+    ChannelCorrection second = first;
+    second.dynamics_frequency_hz = filters.dynamics2_frequency_hz;
+    second.dynamics_damping = filters.dynamics2_damping;
+    filter_one(s.y, second, s.sample_time, r.shares[1]);
+    const std::vector<double>& fy = r.owned.back();
     for (std::size_t k = 0; k < n; ++k)
-      r.target[k] -= s.y[k];
+      r.shares[1][k] -= fy[k];
+    r.columns.emplace_back(r.shares[1]);
   }
 }
 
@@ -602,16 +709,37 @@ void check_signals(const CorrectionSignals& s, const std::vector<bool>& fit_rows
   }
 }
 
+// The shares of the modes and of the direct path (kSecondMode) are fractions of the strain:
+// each, and the first mode's 1 - a - b, in [0, 1]. A setting whose least squares leave that
+// range is not taken (two modes at one frequency with shares 1.9 and -0.93 are one mode's shape
+// refitted; a "mode" at 35 Hz with damping 1.06 and share -0.02 is a lag of something else).
+bool shares_are_fractions(const Columns& columns, const ChannelCorrection& filters,
+                          const Solved& solved) {
+  if (!columns.mode_shares || !(filters.dynamics_frequency_hz > 0.0)) return true;
+  const auto p = static_cast<Eigen::Index>(columns.phi.size());
+  const bool second = filters.dynamics2_frequency_hz > 0.0;
+  if (solved.coefficients.size() != p + (second ? 2 : 1)) return true;  // refused later
+  const double a = solved.coefficients[p];
+  const double b = second ? solved.coefficients[p + 1] : 0.0;
+  const auto fraction = [](double v) { return v >= 0.0 && v <= 1.0; };
+  return fraction(a) && fraction(b) && fraction(1.0 - a - b);
+}
+
 // The correction of solved coefficients (throws when the model's output would enter inverted).
 ChannelCorrection correction_of(const CorrectionSignals& s, std::span<const CorrectionTerm> terms,
                                 const Columns& columns, const Solved& solved,
                                 const ChannelCorrection& filters) {
-  if (solved.coefficients.size() != static_cast<Eigen::Index>(columns.phi.size())) {
+  const bool shares = columns.mode_shares && filters.dynamics_frequency_hz > 0.0;
+  const bool second = shares && filters.dynamics2_frequency_hz > 0.0;
+  const auto p = static_cast<Eigen::Index>(columns.phi.size());
+  if (solved.coefficients.size() != p + (shares ? 1 : 0) + (second ? 1 : 0)) {
     throw std::invalid_argument("fit_correction: no finite fit (non-finite signals?)");
   }
   ChannelCorrection c = filters;
   c.temperature_reference_degc = s.temperature_reference_degc;
-  apply_coefficients(terms, columns, solved.coefficients, c);
+  apply_coefficients(terms, columns, solved.coefficients.head(p), c);
+  if (shares) c.dynamics_direct = solved.coefficients[p];
+  if (second) c.dynamics2_share = solved.coefficients[p + 1];
   if (!(1.0 + c.gain > 0.0)) {
     // The model's output would enter inverted (or not at all): not a correction of it.
     throw std::invalid_argument("fit_correction: the fit needs 1 + gain <= 0");
@@ -646,6 +774,7 @@ CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const Correct
   const auto evaluate = [&](const ChannelCorrection& filters) {
     fill_regressors(s, columns, filters, work);
     Solved solved = solve(work.target, work.columns, solved_rows);
+    if (!shares_are_fractions(columns, filters, solved)) return false;
     if (solved.sse < best.sse) {
       best = std::move(solved);
       best_filters = filters;
@@ -653,7 +782,8 @@ CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const Correct
     }
     return false;
   };
-  for (const ChannelCorrection& filters : filter_grid(s, terms, start)) {
+  const std::vector<ChannelCorrection> grid = filter_grid(s, terms, start);
+  for (const ChannelCorrection& filters : grid) {
     try {
       evaluate(filters);
     } catch (const std::invalid_argument&) {
@@ -661,6 +791,21 @@ CorrectionFit fit_correction(const CorrectionSignals& s, std::span<const Correct
     }
   }
   refine(s, terms, start, best_filters, evaluate);
+  // The first mode as chosen, or as given where its direct share alone left [0, 1].
+  const ChannelCorrection first =
+      std::isfinite(best.sse) || grid.size() != 1 ? best_filters : grid.front();
+  if (has_term(terms, CorrectionTerm::kSecondMode) && start.dynamics2_frequency_hz == 0.0 &&
+      first.dynamics_frequency_hz > 0.0) {
+    // The second mode beside the first, then refined (with the first where it was searched).
+    for (const ChannelCorrection& filters : second_mode_grid(s, first)) {
+      try {
+        evaluate(filters);
+      } catch (const std::invalid_argument&) {
+        // above what the sample time allows: skipped
+      }
+    }
+    if (best_filters.dynamics2_frequency_hz > 0.0) refine(s, terms, start, best_filters, evaluate);
+  }
   CorrectionFit fit;
   fit.correction = correction_of(s, terms, columns, best, best_filters);
   fit.output = apply_correction(s, fit.correction);

@@ -132,7 +132,7 @@ std::optional<InputRange> read_range(YamlMap& map, std::string_view key) {
 // The scalar keys of a correction (channel_correction.hpp), shared by reading and writing.
 template <typename C>
 auto correction_scalars(C& c) {
-  return std::array<std::pair<const char*, decltype(&c.gain)>, 24>{{
+  return std::array<std::pair<const char*, decltype(&c.gain)>, 28>{{
       {"gain", &c.gain},
       {"offset", &c.offset},
       {"temperature_reference_degc", &c.temperature_reference_degc},
@@ -155,6 +155,10 @@ auto correction_scalars(C& c) {
       {"sensed_quadratic", &c.sensed_quadratic},
       {"dynamics_frequency_hz", &c.dynamics_frequency_hz},
       {"dynamics_damping", &c.dynamics_damping},
+      {"dynamics_direct", &c.dynamics_direct},
+      {"dynamics2_frequency_hz", &c.dynamics2_frequency_hz},
+      {"dynamics2_damping", &c.dynamics2_damping},
+      {"dynamics2_share", &c.dynamics2_share},
       {"leakage_tau_s", &c.leakage_tau_s},
       {"delay_s", &c.delay_s},
   }};

@@ -45,6 +45,10 @@ bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) co
       {"sensed_quadratic", sensed_quadratic},
       {"dynamics_frequency_hz", dynamics_frequency_hz},
       {"dynamics_damping", dynamics_damping},
+      {"dynamics_direct", dynamics_direct},
+      {"dynamics2_frequency_hz", dynamics2_frequency_hz},
+      {"dynamics2_damping", dynamics2_damping},
+      {"dynamics2_share", dynamics2_share},
       {"leakage_tau_s", leakage_tau_s},
       {"delay_s", delay_s}};
   namespace check = base::check;
@@ -69,6 +73,20 @@ bool ChannelCorrection::is_valid(const std::string& prefix, std::string* why) co
          check::require(dynamics_frequency_hz == 0.0 || dynamics_damping > 0.0,
                         key("dynamics_damping"), dynamics_damping,
                         "must be > 0 with a dynamics frequency", why) &&
+         check::require(dynamics2_frequency_hz >= 0.0, key("dynamics2_frequency_hz"),
+                        dynamics2_frequency_hz, "must be >= 0 (0: one mode)", why) &&
+         check::require(dynamics2_frequency_hz == 0.0 || dynamics2_damping > 0.0,
+                        key("dynamics2_damping"), dynamics2_damping,
+                        "must be > 0 with a second mode's frequency", why) &&
+         check::require(dynamics_frequency_hz > 0.0 || dynamics2_frequency_hz == 0.0,
+                        key("dynamics2_frequency_hz"), dynamics2_frequency_hz,
+                        "needs dynamics_frequency_hz (the first mode)", why) &&
+         check::require(dynamics_frequency_hz > 0.0 || dynamics_direct == 0.0,
+                        key("dynamics_direct"), dynamics_direct,
+                        "needs dynamics_frequency_hz (the share of no mode beside one)", why) &&
+         check::require(dynamics2_frequency_hz > 0.0 || dynamics2_share == 0.0,
+                        key("dynamics2_share"), dynamics2_share,
+                        "needs dynamics2_frequency_hz (the second mode)", why) &&
          check::require(leakage_tau_s >= 0.0, key("leakage_tau_s"), leakage_tau_s,
                         "must be >= 0 (0: none)", why) &&
          check::non_negative(key("delay_s"), delay_s, why) &&
@@ -180,6 +198,12 @@ CorrectionStage::CorrectionStage(const ChannelCorrection& correction, double sam
     b1_ = 2.0 * b0_;
     b2_ = b0_;
     dynamics_ = true;
+    if (c_.dynamics2_frequency_hz > 0.0) {
+      second_ = mode_coefficients(c_.dynamics2_frequency_hz, c_.dynamics2_damping, sample_time);
+    }
+    direct_ = c_.dynamics_direct;
+    second_share_ = c_.dynamics2_share;
+    mixed_modes_ = direct_ != 0.0 || second_share_ != 0.0;
   }
   if (c_.leakage_tau_s > 0.0) {
     const double r = sample_time / c_.leakage_tau_s;
@@ -247,10 +271,17 @@ double CorrectionStage::filters(double v) noexcept {
   double w = v;
   if (dynamics_) {
     w = b0_ * v + b1_ * v1_ + b2_ * v2_ - a1_ * w1_ - a2_ * w2_;
-    v2_ = v1_;
-    v1_ = v;
     w2_ = w1_;
     w1_ = w;
+    if (mixed_modes_) {
+      const double h2 =
+          second_.b0 * (v + 2.0 * v1_ + v2_) - second_.a1 * second_w1_ - second_.a2 * second_w2_;
+      second_w2_ = second_w1_;
+      second_w1_ = h2;
+      w += direct_ * (v - w) + second_share_ * (h2 - w);
+    }
+    v2_ = v1_;
+    v1_ = v;
   }
   if (leakage_) {
     m_ = leak_g_ * m_ + leak_c_ * (w - w_prev_);
@@ -314,7 +345,7 @@ double CorrectionStage::step(const Inputs& in) noexcept {
     v += c_.creep_weights[j] * (z_[j] - y0_);
   }
   if (first) {  // the filters start at the first value: no ringing, no decay yet
-    v1_ = v2_ = w1_ = w2_ = v;
+    v1_ = v2_ = w1_ = w2_ = second_w1_ = second_w2_ = v;
     m_ = w_prev_ = v;
     line_.fill(v);
     return v;
@@ -325,7 +356,7 @@ double CorrectionStage::step(const Inputs& in) noexcept {
 double CorrectionStage::filter(double v) noexcept {
   if (!started_) {  // the filters start at the first value, as in step()
     started_ = true;
-    v1_ = v2_ = w1_ = w2_ = v;
+    v1_ = v2_ = w1_ = w2_ = second_w1_ = second_w2_ = v;
     m_ = w_prev_ = v;
     line_.fill(v);
     return v;
@@ -382,7 +413,7 @@ double CorrectionStage::solve_stress(double t_lin, double coupling,
 
 void CorrectionStage::save_state(std::span<double> out) const noexcept {
   std::size_t i = 0;
-  const double head[15] = {started_ ? 1.0 : 0.0,
+  const double head[17] = {started_ ? 1.0 : 0.0,
                            y0_,
                            v1_,
                            v2_,
@@ -396,7 +427,9 @@ void CorrectionStage::save_state(std::span<double> out) const noexcept {
                            plays_started_ ? 1.0 : 0.0,
                            memory_started_ ? 1.0 : 0.0,
                            x0_,
-                           integral_};
+                           integral_,
+                           second_w1_,
+                           second_w2_};
   for (const double v : head)
     out[i++] = v;
   for (const double v : z_)
@@ -428,6 +461,8 @@ void CorrectionStage::restore_state(std::span<const double> in) noexcept {
   memory_started_ = in[i++] != 0.0;
   x0_ = in[i++];
   integral_ = in[i++];
+  second_w1_ = in[i++];
+  second_w2_ = in[i++];
   for (double& v : z_)
     v = in[i++];
   for (double& v : u_)

@@ -79,10 +79,11 @@ void add_correction(Fnv1a& h, const std::optional<ChannelCorrection>& c) noexcep
   if (c->drive_linear != 0.0) h.add(c->drive_linear);  // likewise for corrections without it
   // Terms added later: hashed only when used, so older corrections keep their identity.
   // Each tagged by its place, so one value in another of them is another identity.
-  const double later[] = {c->temperature_gain_per_k2,  c->temperature_offset_per_k2,
-                          c->drive_integral_per_s,     c->temperature_drive_per_k2,
-                          c->temperature_stress_per_k, c->temperature_stress_per_k2,
-                          c->stress_drive_per_pa,      c->stress_linear_per_pa};
+  const double later[] = {
+      c->temperature_gain_per_k2,  c->temperature_offset_per_k2, c->drive_integral_per_s,
+      c->temperature_drive_per_k2, c->temperature_stress_per_k,  c->temperature_stress_per_k2,
+      c->stress_drive_per_pa,      c->stress_linear_per_pa,      c->dynamics_direct,
+      c->dynamics2_frequency_hz,   c->dynamics2_damping,         c->dynamics2_share};
   for (std::uint64_t i = 0; i < std::size(later); ++i) {
     if (later[i] == 0.0) continue;
     h.add(std::uint64_t{0x5e1f0000} + i);

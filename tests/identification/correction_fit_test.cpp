@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <vector>
 
@@ -86,6 +87,62 @@ TEST(CorrectionFit, StressGainIsFoundAboutTheRecordingsPreload) {
   for (std::size_t k = 0; k < b.x.size(); ++k)
     worst = std::max(worst, std::abs(fit.output[k] - b.recorded[k]));
   EXPECT_LT(worst, 1e-9);  // of a response up to 2.4
+}
+
+// Two modes in parallel and a share passing neither (models/channel_correction.hpp), planted on
+// steps of a model output: the search finds both frequencies (the second with the first fixed,
+// then both refined) and the shares, where one mode alone leaves far more.
+TEST(CorrectionFit, FindsTwoPlantedModesAndTheDirectShare) {
+  constexpr double kFastTs = 1e-4;
+  models::ChannelCorrection planted;
+  planted.dynamics_frequency_hz = 300.0;
+  planted.dynamics_damping = 0.05;
+  planted.dynamics_direct = 0.1;
+  planted.dynamics2_frequency_hz = 900.0;
+  planted.dynamics2_damping = 0.1;
+  planted.dynamics2_share = 0.3;
+  std::vector<double> y;
+  std::uint64_t state = 12345;
+  double level = 0.0;
+  for (int k = 0; k < 20000; ++k) {
+    if (k % 200 == 0) {  // a step every 20 ms to a level drawn in [-1, 1]
+      state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+      level = static_cast<double>(state >> 11U) * 0x1.0p-52 - 1.0;
+    }
+    y.push_back(level);
+  }
+  CorrectionSignals s;
+  s.y = y;
+  s.drive = y;
+  s.sample_time = kFastTs;
+  const std::vector<double> recorded = apply_correction(s, planted);
+  s.recorded = recorded;
+  const std::vector<bool> rows(y.size(), true);
+  const std::vector<CorrectionTerm> two{CorrectionTerm::kDynamics, CorrectionTerm::kSecondMode};
+  const CorrectionFit fit = fit_correction(s, two, {}, rows);
+  const models::ChannelCorrection& c = fit.correction;
+  EXPECT_NEAR(c.dynamics_frequency_hz, 300.0, 3.0);
+  EXPECT_NEAR(c.dynamics_damping, 0.05, 0.005);
+  EXPECT_NEAR(c.dynamics2_frequency_hz, 900.0, 9.0);
+  EXPECT_NEAR(c.dynamics2_damping, 0.1, 0.01);
+  EXPECT_NEAR(c.dynamics_direct, 0.1, 0.01);
+  EXPECT_NEAR(c.dynamics2_share, 0.3, 0.01);
+  const std::vector<CorrectionTerm> one{CorrectionTerm::kDynamics};
+  const CorrectionFit single = fit_correction(s, one, {}, rows);
+  EXPECT_LT(fit.fit_sse, 1e-3 * single.fit_sse);
+  // Held out with the modes chosen: the shares are refitted per fold, the modes kept.
+  std::vector<int> fold(y.size(), -1);
+  for (std::size_t k = 0; k < 10000; ++k)
+    fold[k] = 0;
+  const std::vector<std::vector<double>> out = held_out_outputs(s, two, c, rows, fold, 1);
+  std::vector<bool> without(y.size(), true);
+  for (std::size_t k = 0; k < 10000; ++k)
+    without[k] = false;
+  const CorrectionFit refit = fit_correction(s, two, c, without);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < y.size(); ++k)
+    largest = std::max(largest, std::abs(out[0][k] - refit.output[k]));
+  EXPECT_LT(largest, 1e-9);
 }
 
 TEST(CorrectionFit, HeldOutOutputsEqualFitsWithoutEachFold) {

@@ -63,6 +63,10 @@ ChannelCorrection strain_correction() {
   c.creep_weights = {0.01, 0.012, 0.015};
   c.dynamics_frequency_hz = 800.0;
   c.dynamics_damping = 0.1;
+  c.dynamics_direct = 0.05;  // a share of the strain passes no mode
+  c.dynamics2_frequency_hz = 2000.0;
+  c.dynamics2_damping = 0.05;
+  c.dynamics2_share = 0.2;
   c.hysteresis_thresholds = {3e5};
   c.hysteresis_weights = {2e-11};
   c.hinge_thresholds = {3e5};
@@ -386,6 +390,51 @@ TEST(ChannelCorrection, ActuatorOnlyModelStaysFinite) {
   for (int k = 0; k < 100; ++k) {
     EXPECT_TRUE(std::isfinite(sim.step(1e6 * std::sin(0.1 * k), 0.0).strain)) << k;
   }
+}
+
+// Two modes in parallel and a direct path: w = (1 - a - b) H1[v] + a v + b H2[v], each mode the
+// one-mode stage's filter; unity DC gain (a step settles at its own height).
+TEST(ChannelCorrection, TwoModesAreTheirSharesOfEachModeAndOfTheDirectPath) {
+  ChannelCorrection both;
+  both.dynamics_frequency_hz = 300.0;
+  both.dynamics_damping = 0.05;
+  both.dynamics_direct = 0.1;
+  both.dynamics2_frequency_hz = 700.0;
+  both.dynamics2_damping = 0.1;
+  both.dynamics2_share = 0.3;
+  ChannelCorrection first;
+  first.dynamics_frequency_hz = 300.0;
+  first.dynamics_damping = 0.05;
+  ChannelCorrection second;
+  second.dynamics_frequency_hz = 700.0;
+  second.dynamics_damping = 0.1;
+  CorrectionStage mixed(both, kTs);
+  CorrectionStage h1(first, kTs);
+  CorrectionStage h2(second, kTs);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < 4000; ++k) {
+    const double v = k < 10 ? 0.0 : 1.0 + 0.1 * std::sin(2e-2 * static_cast<double>(k));
+    const double w = mixed.filter(v);
+    const double expected = 0.6 * h1.filter(v) + 0.1 * v + 0.3 * h2.filter(v);
+    EXPECT_NEAR(w, expected, 1e-12) << k;
+    largest = std::max(largest, std::abs(w - v));
+  }
+  EXPECT_GT(largest, 0.05);  // the modes ring: not the identity
+  CorrectionStage step(both, kTs);
+  double settled = 0.0;
+  for (std::size_t k = 0; k < 20000; ++k)
+    settled = step.filter(k < 10 ? 0.0 : 1.0);
+  EXPECT_NEAR(settled, 1.0, 1e-9);
+  // A share needs its mode.
+  ChannelCorrection orphan;
+  orphan.dynamics2_share = 0.2;
+  std::string why;
+  EXPECT_FALSE(orphan.is_valid("corrections.strain", &why));
+  EXPECT_NE(why.find("corrections.strain.dynamics2_share"), std::string::npos) << why;
+  orphan = ChannelCorrection{};
+  orphan.dynamics_direct = 0.1;
+  EXPECT_FALSE(orphan.is_valid("corrections.strain", &why));
+  EXPECT_NE(why.find("corrections.strain.dynamics_direct"), std::string::npos) << why;
 }
 
 TEST(ChannelCorrection, StepsDoNotAllocate) {

@@ -28,9 +28,22 @@
 #include <span>
 #include <vector>
 
+#include "selfsense/models/channel_correction.hpp"
+
 namespace selfsense::diagnosis {
 
 [[nodiscard]] std::vector<double> mode_undone(std::span<const double> w, double frequency_hz,
                                               double damping, double sample_time);
+
+// A correction's whole dynamics block undone (models/channel_correction.hpp): with a direct path
+// or a second mode, W = (N / D) V with D = A1 A2 and N = (1 - a - b) B1 A2 + a A1 A2 + b B2 A1
+// (B_i = b0_i (1 + z^-1)^2). N's roots (in z) near -1 (the bilinear modes' zeros at Nyquist)
+// are drawn in to modulus 0.6 (rho above), any outside the unit circle mirrored inside, any
+// within 2 % of it drawn to 0.98, so V = D W / N' is a stable causal recursion, rescaled to
+// unity gain at DC and started in steady state; then the zero-phase low-pass at the higher
+// mode's frequency, as above. With neither, mode_undone.
+[[nodiscard]] std::vector<double> modes_undone(std::span<const double> w,
+                                               const models::ChannelCorrection& dynamics,
+                                               double sample_time);
 
 }  // namespace selfsense::diagnosis

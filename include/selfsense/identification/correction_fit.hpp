@@ -4,7 +4,15 @@
 // fixed filter parameters the corrected output is
 //   out = F[y] + sum_i c_i F[phi_i]
 // with phi_i the term regressors (y, 1, (theta - theta_ref) y, x^2, lag outputs of y, ...) and F
-// the filter chain: least squares for c. Filter parameters not given are searched on a
+// the filter chain: least squares for c. With kSecondMode the shares a and b of
+// w = (1 - a - b) H1[v] + a v + b H2[v] are two more columns, R[y] - F[y] and F2[y] - F[y] (R the
+// chain without a mode, F2 with the second in place of the first): linear in a and b for v = y;
+// the products of a and b with the terms' coefficients are left out of the least squares (second
+// order in small corrections) and kept in the corrected output, which runs the stage itself.
+// The shares are fractions of the strain: a setting whose a, b or 1 - a - b leaves [0, 1] is not
+// taken. The second mode is searched on the first's grid with the first fixed (as chosen, or as
+// `start` gives it), then refined (with the first, where that was searched).
+// Filter parameters not given are searched on a
 // logarithmic grid, each point solved by least squares; the grid point is chosen by the error on
 // the fitting rows only (the caller keeps other rows to judge the result).
 //
@@ -35,6 +43,8 @@ enum class CorrectionTerm : std::uint8_t {
   kHysteresis,            // plays of the drive, p_i - x (8 thresholds up to half its range)
   kAsymmetricHysteresis,  // those plays and hinges on them and on x (3 levels each)
   kDynamics,              // searched: f0, zeta
+  kSecondMode,            // beside kDynamics: a second mode (searched: f2, zeta2, with the
+                          // first fixed) and the shares of it and of a direct path (linear)
   kLeakage,               // searched: tau
   kDelay,                 // searched: delay
 };

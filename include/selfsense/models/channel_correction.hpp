@@ -33,7 +33,9 @@
 //   u_j[k] = u_j[k-1] + (1 - exp(-mu_j Ts)) (x[k] - u_j[k-1]),   u_j = x_0 = x at the start
 //   q[k] = q[k-1] + Ts x[k],  q = 0 at the start  (the field's integral [drive unit s])
 //   w = second-order low-pass of v, unity DC gain, f0 and zeta    dynamics
-//       (bilinear transform prewarped at f0)
+//       (bilinear transform prewarped at f0); with a second mode or a direct path
+//   w = (1 - a - b) H1[v] + a v + b H2[v]                       (two modes in parallel, H2 at
+//       f2 and zeta2, and a share a of v that passes neither: unity DC gain still)
 //   m[k] = g m[k-1] + c (w[k] - w[k-1]),  g = exp(-Ts/tau), c = (1 - g) tau / Ts,  m = w at the
 //       start                                                     charge_leakage
 //   out[k] = m(k Ts - delay)  (linear interpolation, delay <= 64 samples)        delay
@@ -102,6 +104,10 @@ struct ChannelCorrection {
   std::vector<double> drive_creep_weights{};      // [channel unit / drive unit]
   double dynamics_frequency_hz{0.0};              // 0: none
   double dynamics_damping{0.0};
+  double dynamics_direct{0.0};         // a: the share of v that passes no mode
+  double dynamics2_frequency_hz{0.0};  // 0: one mode
+  double dynamics2_damping{0.0};
+  double dynamics2_share{0.0};                  // b: the second mode's share
   double leakage_tau_s{0.0};                    // 0: none
   double delay_s{0.0};                          // 0: none
   std::vector<double> hysteresis_thresholds{};  // r_i > 0, increasing [unit of the drive]
@@ -110,7 +116,8 @@ struct ChannelCorrection {
   std::vector<double> hinge_levels{};      // b_h [unit of the drive]
   std::vector<double> hinge_weights{};
 
-  // Every value finite, sizes agree, dynamics_damping > 0 with a frequency, taus and delay
+  // Every value finite, sizes agree, dynamics_damping > 0 with a frequency (each mode), a
+  // second mode, a direct share or a second share only beside a first mode, taus and delay
   // >= 0; names the key under `prefix` ("corrections.sensed.leakage_tau_s: ...").
   [[nodiscard]] bool is_valid(const std::string& prefix, std::string* why) const;
   // Closed-form inverse exists (header comment); otherwise *why names the term.
@@ -183,7 +190,7 @@ class CorrectionStage {
  private:
   static constexpr std::size_t kLine = kMaxCorrectionDelaySamples + 2;
   static constexpr std::size_t kStateSize =
-      15 + 2 * kMaxCorrectionCreep + kMaxCorrectionPlays + 2 * kLine;
+      17 + 2 * kMaxCorrectionCreep + kMaxCorrectionPlays + 2 * kLine;
 
   double terms(const Inputs& in) const noexcept;  // the additive/gain terms except creep and T
   // stress_gain r + stress_drive x + stress_linear + (temperature_stress + temperature_stress2
@@ -205,8 +212,11 @@ class CorrectionStage {
   std::array<double, kMaxCorrectionCreep> drive_alpha_{};  // 1 - exp(-mu Ts)
   std::size_t drive_creep_count_{0};
   double ts_{0.0};
-  // Dynamics: w[k] = b0 v[k] + b1 v[k-1] + b2 v[k-2] - a1 w[k-1] - a2 w[k-2].
+  // Dynamics: w[k] = b0 v[k] + b1 v[k-1] + b2 v[k-2] - a1 w[k-1] - a2 w[k-2]; the second
+  // mode the same with its own coefficients and outputs (its inputs are v's).
   double b0_{1.0}, b1_{0.0}, b2_{0.0}, a1_{0.0}, a2_{0.0};
+  ModeCoefficients second_{};
+  double direct_{0.0}, second_share_{0.0};
   double leak_g_{0.0}, leak_c_{1.0};
   std::size_t delay_whole_{0};
   double delay_frac_{0.0};
@@ -215,14 +225,15 @@ class CorrectionStage {
   std::array<std::size_t, kMaxCorrectionHinges> hinge_row_{};
   std::size_t hinge_count_{0};
   // State (saved in this order): started, y0, v1, v2, w1, w2, m, w_prev, head, drive_head,
-  // drive_started, plays_started, memory_started, x0, integral; creep z; drive lags u; plays;
-  // the output and drive delay lines (rings).
+  // drive_started, plays_started, memory_started, x0, integral, second_w1, second_w2; creep z;
+  // drive lags u; plays; the output and drive delay lines (rings).
   bool memory_started_{false};
   double x0_{0.0};
   double integral_{0.0};
   std::array<double, kMaxCorrectionCreep> u_{};
   double y0_{0.0};
   double v1_{0.0}, v2_{0.0}, w1_{0.0}, w2_{0.0};
+  double second_w1_{0.0}, second_w2_{0.0};
   double m_{0.0}, w_prev_{0.0};
   std::array<double, kMaxCorrectionCreep> z_{};
   std::array<double, kMaxCorrectionPlays> plays_{};
@@ -231,6 +242,7 @@ class CorrectionStage {
   std::array<double, kLine> drive_line_{};
   std::size_t drive_head_{0};
   bool dynamics_{false};
+  bool mixed_modes_{false};  // a direct path or a second mode beside the first
   bool leakage_{false};
   bool delay_{false};
   bool started_{false};
