@@ -518,6 +518,10 @@ bool creep_moves_with_the_step(const ChannelCorrection& c) {
           lags_move_with_the_step(c.drive_creep_eigenvalues, c.drive_creep_weights));
 }
 
+bool extensible(const ChannelCorrection& simpler_fit) {
+  return simpler_fit.dynamics_damping < kNoResonanceDamping;
+}
+
 bool named_already(const std::vector<const Candidate*>& used, const Candidate& c) {
   return std::any_of(used.begin(), used.end(), [&](const Candidate* u) {
     return std::string_view(u->effect) == std::string_view(c.effect);

@@ -53,8 +53,9 @@ struct Candidate {
   // periodic drive): chosen only when no specific physics explains the residual significantly.
   bool generic{false};
   // A richer form of the candidate listed just before it (two modes beside one): tried only
-  // where that one explains enough on the held-out blocks to be named in the same round, its
-  // search starting from that one's filters (the first mode kept); not tried on one stretch.
+  // where that one's fit is extensible() and explains enough on the held-out blocks to be named
+  // in the same round (on one stretch: is the best there so far), with that one's filters kept
+  // (the second mode searched beside its mode); not tried by the absorbed pass.
   bool extends_previous{false};
 };
 
@@ -70,6 +71,11 @@ struct Candidate {
 // Time since the drive last moved by more than 5 % of its range, log10 seconds: the feature
 // creep follows.
 [[nodiscard]] std::vector<double> log_time_since_step(std::span<const double> x, double ts);
+
+// A richer form (Candidate::extends_previous) is tried beside its simpler one's fit only where
+// that fit reads as the same effect: a mode without a resonant peak is a lag, named `delay`
+// (describe_dynamics), and a second mode is not built on it.
+[[nodiscard]] bool extensible(const ChannelCorrection& simpler_fit);
 
 // Creep keeps moving in the direction of the last step (candidates.cpp).
 [[nodiscard]] bool creep_moves_with_the_step(const ChannelCorrection& c);

@@ -75,7 +75,7 @@ void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>&
         const auto previous = std::find_if(tried.begin(), tried.end(),
                                            [&](const Tried& t) { return t.candidate == simpler; });
         if (previous == tried.end() || !large_enough(*previous) ||
-            !passes_blocks(previous->blocks, in.options)) {
+            !passes_blocks(previous->blocks, in.options) || !extensible(previous->fit.correction)) {
           continue;
         }
         take_filters(seed, previous->fit.correction);
@@ -249,7 +249,7 @@ void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& fi
       // filters (the information criterion then weighs the parameters it adds).
       ChannelCorrection seed;
       if (c.extends_previous) {
-        if (best != &c - 1) continue;
+        if (best != &c - 1 || !extensible(best_found)) continue;
         take_filters(seed, best_found);
       }
       identification::CorrectionFit local;

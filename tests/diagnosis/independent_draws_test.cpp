@@ -329,11 +329,11 @@ const Mechanism kMechanisms[] = {
     {"FastDampedModeIsNamedAsAModeNotADelay", Effect::kDynamics, 2400008},
     // Two modes on S (90 Hz, zeta 0.22, share 0.63; 189 Hz, zeta 0.079, share 0.37), with the
     // base identified on the same recording: one mode named in one stretch (99 Hz) carried
-    // nothing to new data (validation S 0.374 -> 0.384 %, clean 0.099 %: excess 1.03x; before
-    // that, `delay` at 0.77x). With two modes and a direct path (99 Hz, 0.29, share 0.68; 173 Hz,
-    // 0.10, share 0.28; 0.04 passing neither) named in that stretch and the side re-identified
-    // with both undone, validation S falls to 0.140 % (excess 0.15x, measured). Seed 3800037 is
-    // a draw of the proof run on seed base 3800000 (docs/diagnose.md), traced after it.
+    // nothing to new data (validation S 0.374 -> 0.384 %, clean 0.099 %: excess 1.03x). With
+    // two modes and a direct path (99 Hz, 0.29, share 0.68; 173 Hz, 0.10, share 0.28; 0.04
+    // passing neither) named in that stretch and the side re-identified with both undone,
+    // validation S falls to 0.140 % (excess 0.15x, measured). Seed 3800037 is a draw of the
+    // proof run on seed base 3800000 (docs/diagnose.md), traced after it.
     {"TwoModesAreUndoneTogether", Effect::kDynamics, 3800037},
     // The converse: S sampled 0.45 samples late (cubic interpolation), with the base identified
     // on the same recording. A second-order low-pass fits the lag best (422 Hz, damping 1.2 at
