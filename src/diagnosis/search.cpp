@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string_view>
 
@@ -239,6 +240,11 @@ void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& fi
     const Candidate* best = nullptr;
     ChannelCorrection best_found;
     double best_bic = -kLocalEvidence;
+    // The simpler form a richer one displaced as the best: named instead where the richer one
+    // does not hold over the whole record.
+    const Candidate* simpler = nullptr;
+    ChannelCorrection simpler_found;
+    double simpler_bic = 0.0;
     for (const Candidate& c : candidates()) {
       if (named_already(st.used, c)) continue;
       if (!applicable(c, in.ch, in.s, in.has_sensor, in.charge_drive)) continue;
@@ -263,25 +269,48 @@ void local_pass(const SearchInput& in, SearchState& st, std::vector<Finding>& fi
       const double bic = seg_n * std::log(std::max(after, 1e-300) / before) +
                          static_cast<double>(complexity(c.terms)) * std::log(seg_n);
       if (after <= 0.5 * before && bic < best_bic) {
+        if (c.extends_previous) {
+          simpler = best;
+          simpler_found = best_found;
+          simpler_bic = best_bic;
+        }
         best_bic = bic;
         best = &c;
         best_found = local.correction;
       }
     }
     if (best == nullptr) continue;
-    ChannelCorrection start = st.accepted;
-    take_filters(start, best_found);
-    const std::vector<CorrectionTerm> terms = merged(st.accepted_terms, best->terms);
-    identification::CorrectionFit joint;
-    try {
-      joint = identification::fit_correction(in.cs, terms, start, in.rows.fit);
-    } catch (const std::invalid_argument&) {
-      continue;
-    }
     const double held_before = sse_over(in.ch.recorded, st.current, in.rows.judge);
+    // Every coefficient refitted over the whole record with the stretch's filters; named where
+    // that does not lose on the held-out blocks and keeps the stretch's gain.
+    const auto joint_fit =
+        [&](const Candidate& chosen, const ChannelCorrection& found,
+            std::vector<CorrectionTerm>& terms) -> std::optional<identification::CorrectionFit> {
+      ChannelCorrection start = st.accepted;
+      take_filters(start, found);
+      terms = merged(st.accepted_terms, chosen.terms);
+      try {
+        identification::CorrectionFit joint =
+            identification::fit_correction(in.cs, terms, start, in.rows.fit);
+        const double held_after = sse_over(in.ch.recorded, joint.output, in.rows.judge);
+        const double seg_after = segment_sse(in.ch.recorded, joint.output, seg);
+        if (held_after > 1.02 * held_before || seg_after > 0.5 * before) return std::nullopt;
+        return joint;
+      } catch (const std::invalid_argument&) {
+        return std::nullopt;
+      }
+    };
+    std::vector<CorrectionTerm> terms;
+    std::optional<identification::CorrectionFit> held = joint_fit(*best, best_found, terms);
+    if (!held && simpler != nullptr) {
+      best = simpler;
+      best_bic = simpler_bic;
+      held = joint_fit(*best, simpler_found, terms);
+    }
+    if (!held) continue;
+    const identification::CorrectionFit& joint = *held;
     const double held_after = sse_over(in.ch.recorded, joint.output, in.rows.judge);
     const double seg_after = segment_sse(in.ch.recorded, joint.output, seg);
-    if (held_after > 1.02 * held_before || seg_after > 0.5 * before) continue;
     Finding f;
     f.effect = best->effect;
     f.channel = in.ch.name;
