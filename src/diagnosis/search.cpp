@@ -71,7 +71,7 @@ void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>&
       ChannelCorrection seed;  // filters chosen before this candidate's own search
       if (c.extends_previous) {
         // Tried where the candidate before it (its simpler form) is significant on the held-out
-        // blocks this round, from that candidate's filters.
+        // blocks this round and its fit is extensible(), with that candidate's filters kept.
         const Candidate* simpler = &c - 1;
         const auto previous = std::find_if(tried.begin(), tried.end(),
                                            [&](const Tried& t) { return t.candidate == simpler; });
