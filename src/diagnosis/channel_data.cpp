@@ -32,8 +32,12 @@ std::vector<bool> hold_finite(std::vector<double>& y) {
   return usable;
 }
 
+double coupling_of(const models::SideModel& side) {
+  return side.linear_gains.empty() ? 0.0 : side.linear_gains.front();
+}
+
 double coupling_of(const std::optional<models::SideModel>& side) {
-  return (side && !side->linear_gains.empty()) ? side->linear_gains.front() : 0.0;
+  return side ? coupling_of(*side) : 0.0;
 }
 
 }  // namespace selfsense::diagnosis::detail

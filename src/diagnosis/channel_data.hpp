@@ -43,8 +43,9 @@ struct ChannelData {
   std::span<const double> sensed_model{};  // the model's sensed response (electrostriction)
   bool affine{true};  // not the stress-hysteresis model: the response is G[x] + y0
   // The diagnosis replaced the model by a structure identified on this record, its loop too
-  // (reidentified.hpp, reidentified_stress): a loop shape left over is that structure's own
-  // class, so the generic loop candidates are not tried on it.
+  // (reidentified.hpp: reidentified_stress, or the model's structure with the stress's terms
+  // undone, reidentified_stress_terms): a loop shape left over is that structure's own class,
+  // so the generic loop candidates are not tried on it.
   bool loop_reidentified{false};
   // Shared by the channel's copies (the recording they read is the same).
   std::shared_ptr<FirstHalfFits> first_half{std::make_shared<FirstHalfFits>()};
@@ -59,6 +60,7 @@ struct ChannelData {
 [[nodiscard]] std::vector<bool> hold_finite(std::vector<double>& y);
 
 // The stress coupling of a side (its first linear gain), 0 without one.
+[[nodiscard]] double coupling_of(const models::SideModel& side);
 [[nodiscard]] double coupling_of(const std::optional<models::SideModel>& side);
 
 }  // namespace selfsense::diagnosis::detail

@@ -115,6 +115,11 @@ void search_rounds(const SearchInput& in, SearchState& st, std::vector<Finding>&
     if (tried.empty()) break;
     if (round == 0) {
       double mode_explains = -std::numeric_limits<double>::infinity();
+      const auto leader =
+          std::max_element(tried.begin(), tried.end(),
+                           [](const Tried& a, const Tried& b) { return a.explains < b.explains; });
+      st.stress_leads = std::string_view(leader->candidate->effect) == "stress_dependence" &&
+                        leader->explains > 0.0;
       for (const Tried& t : tried) {
         const bool mode = uses_term(*t.candidate, CorrectionTerm::kDynamics);
         if (mode || uses_term(*t.candidate, CorrectionTerm::kDelay)) {

@@ -42,6 +42,10 @@ struct SearchState {
   // The dynamics block of a named correction with two modes or a direct path (the filters
   // alone): tried as it is beside the modes around lag_mode when the lag is re-identified.
   ChannelCorrection named_modes{};
+  // In the first round a stress candidate explained more of the held-out residual than any
+  // other candidate, and more than nothing, significant or not: where the rounds name nothing,
+  // the evidence that the side is worth re-identifying with the stress's terms undone.
+  bool stress_leads{false};
 };
 
 // Rounds of candidates until none is significant (or options.max_effects): findings appended.

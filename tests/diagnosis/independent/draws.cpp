@@ -320,6 +320,13 @@ Outcome run_draw(std::uint64_t seed, Effect effect) {
     if (result.improved.actuator) o.improved += ", S plain";
   }
 
+  // The improved model as the runtime runs it against the output each finding was judged on.
+  const diagnosis::Outputs rerun = diagnosis::simulate(result.improved, signals(trial.recording));
+  for (const diagnosis::ChannelResult& c : result.channels) {
+    const std::vector<double>& y = c.channel == "D" ? rerun.sensed : rerun.strain;
+    o.model_gap = std::max(o.model_gap, nrmse(c.after, y));
+  }
+
   const Recording val = record(o.draw, {.excitation = 1});
   const Recording val_clean = record(o.draw, {.excitation = 1, .effect = false});
   const diagnosis::Outputs before = diagnosis::simulate(trial.fit.model, signals(val));
@@ -345,8 +352,11 @@ std::string summary(const Outcome& o) {
       o.named_right ? 1 : 0, o.extra_names, 100 * o.d.before, 100 * o.d.after, 100 * o.d.clean,
       100 * o.s.before, 100 * o.s.after, 100 * o.s.clean, o.excess_ratio, o.pass ? "PASS" : "fail",
       o.seconds, o.seconds_diagnose));
+  std::array<char, 64> gap{};
+  static_cast<void>(
+      std::snprintf(gap.data(), gap.size(), "; runs as judged within %.2g %%)", 100 * o.model_gap));
   return std::string(buf.data()) + "\n    form: " + describe(o.draw) + "; expected [" +
-         names(o.expected) + "] (base " + o.structure + "; improved " + o.improved + ")";
+         names(o.expected) + "] (base " + o.structure + "; improved " + o.improved + gap.data();
 }
 
 }  // namespace selfsense::independent

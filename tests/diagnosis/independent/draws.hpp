@@ -59,6 +59,10 @@ struct Outcome {
   ChannelFigures d{};
   ChannelFigures s{};
   double excess_ratio{0.0};  // NaN when the effect does not raise the validation error
+  // The improved model run by the runtime (diagnosis::simulate) on the diagnosed recording
+  // against the output the diagnosis judged it by (ChannelResult::after): the nrmse between
+  // the two, largest over the channels. A model that is not the one judged shows here.
+  double model_gap{0.0};
   bool pass{false};
   double seconds{0.0};           // the whole draw
   double seconds_diagnose{0.0};  // ... of which the diagnosis
