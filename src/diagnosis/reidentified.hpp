@@ -125,8 +125,10 @@ struct CreepAndLeak {
 // and loop size move with the stress bends an affine base to it, and no correction after it
 // carries to new loads. The null is the model's structure identified on the first half of both
 // channels, the candidate `stress-hysteresis` (D or S = W0.q + T W1.q + d1 T + d2 T^2, the plays
-// of the field: loop and permittivity scaled by T, coupling quadratic in T) identified there too;
-// each channel where it forecasts the second half better by forecast_explains is named. A
+// of the field: loop and permittivity scaled by T, coupling quadratic in T) identified there too
+// (and each on the second half, forecasting the first); each channel it forecasts better by the
+// rules of a round, the halves the unit of harm, is named where the structure identified on the
+// whole record also fits it by min_explains better than the given model (below). A
 // channel it forecasts worse keeps the model's own side (the plain side's dead zones and creep
 // can fit a channel without the effect better than the structure's plays), the others take the
 // structure's (models/stress_sides.hpp). The improved model is that structure identified on the

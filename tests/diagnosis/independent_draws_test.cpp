@@ -388,7 +388,9 @@ const Mechanism kMechanisms[] = {
     // but left validation D at 0.102 % (before 0.142 %, clean 0.031 %: excess 0.64x). With the
     // sensor side identified again with the stress's terms undone (as the temperature's), D
     // falls to 0.030 % (excess 0.00x, measured; docs/diagnose.md, "Stress on D re-identified
-    // with its terms undone"). Seed 2600005 is a draw of the proof run on seed base 2600000.
+    // with its terms undone"). Since one side may be kept (2026-12-06) the stress-hysteresis
+    // structure takes D beside S's own side: D 0.064 % (excess 0.29x, measured 2026-12-07).
+    // Seed 2600005 is a draw of the proof run on seed base 2600000.
     {"StressOnDTheBaseBentToIsNamedWithItsTermsUndone", Effect::kStress, 2600005},
     // A coupling that falls with compression (d (1 + k T), k = 3.7e-8 /Pa, about 11 % at the
     // recording's -3 MPa preload), with an affine base identified on the same recording: the
