@@ -215,8 +215,7 @@ std::optional<StressReidentified> reidentified_stress(const models::TransducerMo
     // The unseen halves by the rules of a round with the halves as the unit of harm
     // (forecasts_better); the identification's own evidence is the whole record's, below.
     const double explains = 1.0 - stress_sse / null_sse;
-    if (explains < options.min_explains ||
-        !forecasts_better(ch.recorded, a, b, rows, options)) {
+    if (explains < options.min_explains || !forecasts_better(ch.recorded, a, b, rows, options)) {
       continue;
     }
     Finding f;
