@@ -284,11 +284,10 @@ std::optional<Reidentified> reidentified_stress_terms(const models::TransducerMo
                                                       const std::vector<double>& current,
                                                       const Options& options) {
   const std::size_t n = s.drive.size();
-  // Both channels. The terms read the response to the drive alone, y - d T (Identifier): read
-  // on y, the gain per pascal on S scaled the compliance too (a k s T^2 the stack does not
-  // have), which fitted the held-out blocks and carried badly to new loads (the validation S
-  // of 4 of 10 development draws 1.1-2x worse; traced on 3800037: 1.39 -> 6.07 %, with the
-  // response 0.14 %), so S was left out.
+  // Both channels. S was left out while the joint read the terms on y (the validation S of 4 of
+  // 10 development draws 1.1-2x worse): the model runs them on the response y - d T, so the
+  // model returned differed from the one judged by k s T^2 on S (k d T^2 on D). Read on the
+  // response (Identifier), 3800037's validation S is 0.14 % where it was 6.07 %.
   if (!has_own_side(model, ch) || n < 1000 || s.stress.size() != n) {
     return std::nullopt;
   }
