@@ -14,6 +14,7 @@
 #include "search.hpp"
 #include "selfsense/diagnosis/statistics.hpp"
 #include "selfsense/models/runtime_model.hpp"
+#include "text.hpp"
 
 namespace selfsense::diagnosis {
 namespace {
@@ -267,8 +268,27 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
     if (!reidentified && (st.rounds_named == 0 || only_lags)) {
       const LagSeen seen =
           st.lag_explains >= options.min_explains ? LagSeen::kInRounds : LagSeen::kNo;
-      std::optional<Reidentified> late =
-          reidentified_lag(model, s, ch, model_output, options, st.lag_mode, seen, st.named_modes);
+      // A delay the rounds named alone: the side identified with it undone carries it where it
+      // fits the record better than the delay after the model (the same class and parameter
+      // count: the side fitted with the delay jointly against the side fitted without it and the
+      // delay after; the rounds' held-out test has named it already).
+      const Finding* named_delay =
+          found.size() == 1 && found.front().effect == "delay" ? &found.front() : nullptr;
+      std::optional<Reidentified> late = reidentified_lag(
+          model, s, ch, model_output, options, st.lag_mode, seen, st.named_modes, named_delay);
+      if (late && late->carried) {
+        const double carried_sse = sse_over(ch.recorded, late->output, rows.judge);
+        if (carried_sse < st.current_sse) {
+          late->finding.evidence += format(
+              "; carried by the model's side identified again with a delay of %.3g samples "
+              "undone, which fits the record %.0f %% better than the delay after the model (the "
+              "side had taken part of the delay in)",
+              late->correction.delay_s / s.sample_time,
+              100.0 * (1.0 - carried_sse / st.current_sse));
+        } else {
+          late.reset();
+        }
+      }
       if (late) search_again(*late, {});
     }
     result.findings.insert(result.findings.end(), std::make_move_iterator(found.begin()),

@@ -8,6 +8,7 @@
 #include "candidates.hpp"
 #include "held_out.hpp"
 #include "selfsense/diagnosis/mode_undone.hpp"
+#include "selfsense/diagnosis/read_later.hpp"
 #include "selfsense/identification/transducer_fit.hpp"
 #include "text.hpp"
 
@@ -34,25 +35,16 @@ class Judge {
   [[nodiscard]] std::size_t half() const { return half_; }
 
   // The channel as the model would see it without the effect: a delay is undone by reading
-  // the record that much later (linear interpolation, the last sample held), a mode by its
-  // offline inverse (mode_undone.hpp), a leak by the correction stage's inverse.
+  // the record that much later (read_later), a mode by its offline inverse (mode_undone.hpp), a
+  // leak by the correction stage's inverse.
   [[nodiscard]] std::vector<double> undone(const models::ChannelCorrection& effect) const {
     const std::span<const double> x = ch_.recorded;
     if (effect.dynamics_frequency_hz > 0.0) {
       return modes_undone(x, effect, s_.sample_time);
     }
+    if (effect.delay_s > 0.0) return read_later(x, effect.delay_s / s_.sample_time);
     std::vector<double> out(x.begin(), x.end());
     if (effect.empty()) return out;
-    if (effect.delay_s > 0.0) {
-      const double samples = effect.delay_s / s_.sample_time;
-      for (std::size_t k = 0; k < out.size(); ++k) {
-        const double p = static_cast<double>(k) + samples;
-        const auto i = static_cast<std::size_t>(std::floor(p));
-        const double f = p - std::floor(p);
-        out[k] = i + 1 < x.size() ? x[i] + f * (x[i + 1] - x[i]) : x.back();
-      }
-      return out;
-    }
     models::CorrectionStage stage(effect, s_.sample_time);
     for (std::size_t k = 0; k < out.size(); ++k) {
       models::CorrectionStage::Inputs in;
@@ -485,13 +477,11 @@ std::optional<Reidentified> reidentified_leak(const models::TransducerModel& mod
   return r;
 }
 
-std::optional<Reidentified> reidentified_lag(const models::TransducerModel& model, const Signals& s,
-                                             const ChannelData& ch,
-                                             const std::vector<double>& current,
-                                             const Options& options,
-                                             const models::ChannelCorrection& mode_seed,
-                                             LagSeen seen,
-                                             const models::ChannelCorrection& named_modes) {
+std::optional<Reidentified> reidentified_lag(
+    const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
+    const std::vector<double>& current, const Options& options,
+    const models::ChannelCorrection& mode_seed, LagSeen seen,
+    const models::ChannelCorrection& named_modes, const Finding* named_delay) {
   if (!reidentifiable(model, s, ch)) return std::nullopt;
   const Judge judge(model, s, ch);
   const double most = static_cast<double>(models::kMaxCorrectionDelaySamples) * s.sample_time;
@@ -580,6 +570,18 @@ std::optional<Reidentified> reidentified_lag(const models::TransducerModel& mode
     }
   }
   std::optional<Reidentified> r = judged(judge, ch, null, best, options, ShownBy::kFitAndForecast);
+  if (!r && named_delay != nullptr && !mode) {
+    // Named by the rounds: the side identified on the whole record with the delay undone, for
+    // the caller to weigh against the delay after the model (Reidentified::carried).
+    r = identified_whole(judge, best.effect, ch, named_delay->explains);
+    if (!r) return std::nullopt;
+    r->fit_explains = 1.0 - best.first_half_sse / null.first_half_sse;
+    r->candidate = &candidate_using(CorrectionTerm::kDelay);
+    r->terms = r->candidate->terms;
+    r->finding = *named_delay;
+    r->carried = true;
+    return r;
+  }
   if (!r) return std::nullopt;
   const bool two =
       mode && (best.effect.dynamics2_frequency_hz > 0.0 || best.effect.dynamics_direct != 0.0);

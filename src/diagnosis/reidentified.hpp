@@ -54,6 +54,8 @@ struct Reidentified {
   // The structure the side was identified with, when it is not the model's (creep operators
   // added to a hysteresis model).
   std::optional<models::Structure> structure{};
+  // Not judged against the null: a side to carry an effect the rounds named (its finding).
+  bool carried{false};
 };
 
 // Rows of a forecast: the first `half` samples fit, the rest judges in `judging` blocks (the odd
@@ -191,13 +193,21 @@ inline constexpr std::size_t kReidentifiedRows = 200000;
 // shortest up until the fit has worsened twice in a row, and the lag is judged only where the
 // best fits the first half by min_explains better than the null (no backcast in its place, no
 // refinement or mode before that): a few identifications on a channel with no lag.
+//
+// With `named_delay` (the rounds named a delay and nothing else on the channel), a delay that is
+// not judged against the null still comes back, carried (Reidentified::carried, with the rounds'
+// finding): the side identified on the whole record with the delay undone. The caller keeps it
+// where it fits the record better than the rounds' delay after the model: both are the side and
+// one delay, and the joint fit is not biased by the part of the delay the side took in (the
+// rounds read the sub-sample delays on D of 900003, 900006, 900017 and 900027 17-34 % short;
+// docs/diagnose.md, "A delay the rounds named, carried by the side identified with it").
 enum class LagSeen { kInRounds, kNo };
 
 [[nodiscard]] std::optional<Reidentified> reidentified_lag(
     const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
     const std::vector<double>& current, const Options& options,
     const models::ChannelCorrection& mode_seed = {}, LagSeen seen = LagSeen::kInRounds,
-    const models::ChannelCorrection& named_modes = {});
+    const models::ChannelCorrection& named_modes = {}, const Finding* named_delay = nullptr);
 
 }  // namespace selfsense::diagnosis::detail
 
