@@ -58,6 +58,11 @@ void split(const RegisterSpec& spec, std::uint32_t raw, std::span<std::uint16_t>
   words[1] = spec.word_order == WordOrder::kHighFirst ? low : high;
 }
 
+// The register's raw value in the spec's unit: the one formula decode() and encode() share.
+double scaled(const RegisterSpec& spec, double raw) noexcept {
+  return raw * spec.scale + spec.offset;
+}
+
 }  // namespace
 
 Decoded decode(const RegisterSpec& spec, std::span<const std::uint16_t> words) noexcept {
@@ -77,7 +82,7 @@ Decoded decode(const RegisterSpec& spec, std::span<const std::uint16_t> words) n
       break;
   }
   Decoded d;
-  d.value = raw * spec.scale + spec.offset;
+  d.value = scaled(spec, raw);
   if (!std::isfinite(d.value)) {
     d.status = DecodeStatus::kNotFinite;
   } else if (d.value < spec.min || d.value > spec.max) {
@@ -89,30 +94,41 @@ Decoded decode(const RegisterSpec& spec, std::span<const std::uint16_t> words) n
 bool encode(const RegisterSpec& spec, double value, std::span<std::uint16_t> words) noexcept {
   const double raw = (value - spec.offset) / spec.scale;
   if (!std::isfinite(raw)) return false;
+  // The raw value the words will hold; refused where it does not decode to a finite value (an
+  // extreme scale and offset overflow on the way back: scale -3e307, offset -1.8e308).
+  double held = 0.0;
   switch (spec.type) {
-    case RegisterType::kInt16: {
-      const double r = std::nearbyint(raw);
-      if (r < -32768.0 || r > 32767.0) return false;
-      words[0] = std::bit_cast<std::uint16_t>(static_cast<std::int16_t>(r));
-      return true;
-    }
-    case RegisterType::kUint16: {
-      const double r = std::nearbyint(raw);
-      if (r < 0.0 || r > 65535.0) return false;
-      words[0] = static_cast<std::uint16_t>(r);
-      return true;
-    }
-    case RegisterType::kInt32: {
-      const double r = std::nearbyint(raw);
-      if (r < -2147483648.0 || r > 2147483647.0) return false;
-      split(spec, std::bit_cast<std::uint32_t>(static_cast<std::int32_t>(r)), words);
-      return true;
-    }
-    case RegisterType::kFloat32: {
+    case RegisterType::kInt16:
+      held = std::nearbyint(raw);
+      if (held < -32768.0 || held > 32767.0) return false;
+      break;
+    case RegisterType::kUint16:
+      held = std::nearbyint(raw);
+      if (held < 0.0 || held > 65535.0) return false;
+      break;
+    case RegisterType::kInt32:
+      held = std::nearbyint(raw);
+      if (held < -2147483648.0 || held > 2147483647.0) return false;
+      break;
+    case RegisterType::kFloat32:
       if (std::abs(raw) > static_cast<double>(std::numeric_limits<float>::max())) return false;
-      split(spec, std::bit_cast<std::uint32_t>(static_cast<float>(raw)), words);
+      held = static_cast<double>(static_cast<float>(raw));
+      break;
+  }
+  if (!std::isfinite(scaled(spec, held))) return false;
+  switch (spec.type) {
+    case RegisterType::kInt16:
+      words[0] = std::bit_cast<std::uint16_t>(static_cast<std::int16_t>(held));
       return true;
-    }
+    case RegisterType::kUint16:
+      words[0] = static_cast<std::uint16_t>(held);
+      return true;
+    case RegisterType::kInt32:
+      split(spec, std::bit_cast<std::uint32_t>(static_cast<std::int32_t>(held)), words);
+      return true;
+    case RegisterType::kFloat32:
+      split(spec, std::bit_cast<std::uint32_t>(static_cast<float>(held)), words);
+      return true;
   }
   return false;
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -127,6 +128,21 @@ TEST(RegisterMap, NanInfinityAndOutOfRangeAreBadDataNotNumbers) {
   EXPECT_FALSE(encode(s, std::numeric_limits<double>::quiet_NaN(), w));
   EXPECT_FALSE(encode(s, 1e300, w));
   EXPECT_EQ(w[0], 1) << "a refused value leaves the registers untouched";
+}
+
+// Found by the fuzz target (a 10 s run of 2026-12-07): with an extreme scale and offset a value
+// whose raw count fits the type came back as infinity (the fuzzer's: -6 * -3.2e307 overflows
+// before the offset -1.8e308 is added). encode() refuses a value whose registers would not
+// decode finite. Here 1.79e308 rounds to the count 1, which decodes to 1.8e308 even exactly.
+TEST(RegisterMap, AValueWhoseRegistersWouldNotDecodeFiniteIsRefused) {
+  const RegisterSpec s = spec(RegisterType::kInt16, WordOrder::kHighFirst, 1e307, 1.7e308);
+  std::array<std::uint16_t, 1> w{7};
+  EXPECT_FALSE(encode(s, 1.79e308, w));
+  EXPECT_EQ(w[0], 7) << "a refused value leaves the registers untouched";
+  // A value whose count decodes finite still encodes, and decodes back.
+  ASSERT_TRUE(encode(s, 1.6e308, w));
+  EXPECT_EQ(w[0], std::bit_cast<std::uint16_t>(std::int16_t{-1}));
+  EXPECT_DOUBLE_EQ(decode(s, w).value, 1.6e308);
 }
 
 TEST(RegisterMap, DefaultMapIsValidAndProblemsNameTheEntry) {

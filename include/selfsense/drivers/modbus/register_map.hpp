@@ -61,8 +61,9 @@ struct Decoded {
 [[nodiscard]] Decoded decode(const RegisterSpec& spec,
                              std::span<const std::uint16_t> words) noexcept;
 
-// The registers for a value; false (words untouched) when the value is not finite or does not
-// fit the type after scaling (integers are rounded to nearest, never wrapped or clamped).
+// The registers for a value; false (words untouched) when the value is not finite, does not
+// fit the type after scaling (integers are rounded to nearest, never wrapped or clamped) or
+// the registers would not decode to a finite value (an extreme scale and offset).
 [[nodiscard]] bool encode(const RegisterSpec& spec, double value,
                           std::span<std::uint16_t> words) noexcept;
 
