@@ -286,6 +286,11 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
               late->correction.delay_s / s.sample_time,
               100.0 * (1.0 - carried_sse / st.current_sse));
         } else {
+          // The rounds' delay after the model stands; the finding says what was weighed.
+          found.front().evidence += format(
+              "; the model's side identified again with the delay undone fitted the record "
+              "%.0f %% worse than the delay after the model, which stands",
+              100.0 * (carried_sse / st.current_sse - 1.0));
           late.reset();
         }
       }

@@ -312,7 +312,7 @@ Outcome run_draw(std::uint64_t seed, Effect effect) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - diagnosing).count();
   o.verdict = diagnosis::to_string(result.verdict);
   for (const diagnosis::Finding& f : result.findings) {
-    o.findings.push_back({f.effect, f.channel});
+    o.findings.push_back({f.effect, f.channel, f.evidence});
   }
   o.improved = std::string(models::to_string(result.improved.structure));
   if (result.improved.vectorial) {

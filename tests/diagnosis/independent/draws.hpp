@@ -34,6 +34,7 @@ namespace selfsense::independent {
 struct Named {
   std::string effect{};
   std::string channel{};
+  std::string evidence{};  // the finding's (empty for an expected name)
 };
 
 // Validation nrmse of one channel.
