@@ -1,7 +1,10 @@
 #include "selfsense/diagnosis/read_later.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstddef>
+
+#include "selfsense/models/cubic_read.hpp"
 
 namespace selfsense::diagnosis {
 
@@ -22,10 +25,8 @@ std::vector<double> read_later(std::span<const double> x, double samples) {
       out[k] = x[i] + t * (x[i + 1] - x[i]);
       continue;
     }
-    out[k] = -t * (t - 1.0) * (t - 2.0) / 6.0 * x[i - 1] +
-             (t + 1.0) * (t - 1.0) * (t - 2.0) / 2.0 * x[i] -
-             (t + 1.0) * t * (t - 2.0) / 2.0 * x[i + 1] +
-             (t + 1.0) * t * (t - 1.0) / 6.0 * x[i + 2];
+    const std::array<double, 4> w = models::cubic_read_weights(t);
+    out[k] = w[0] * x[i - 1] + w[1] * x[i] + w[2] * x[i + 1] + w[3] * x[i + 2];
   }
   return out;
 }

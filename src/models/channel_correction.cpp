@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "selfsense/base/check.hpp"
+#include "selfsense/models/cubic_read.hpp"
 
 namespace selfsense::models {
 namespace {
@@ -251,16 +252,23 @@ double CorrectionStage::stress_coupling_change(const Inputs& in) const noexcept 
          (c_.temperature_stress_per_k + c_.temperature_stress_per_k2 * dtheta) * dtheta;
 }
 
-// Writes `value` into a ring and reads it back the configured delay later (linear interpolation
-// between the two samples around it).
+// Writes `value` into a ring and reads it back the configured delay later: below one sample by
+// linear interpolation between the two samples around it (no later sample exists), from one
+// sample on by the cubic through the two samples around it and one on each side
+// (models/cubic_read.hpp), which does not low-pass what it reads.
 double CorrectionStage::push_delayed(std::array<double, kLine>& line, std::size_t& head,
                                      double value) const noexcept {
   head = (head + 1) % kLine;
   line[head] = value;
   if (!delay_) return value;
-  const double a = line[(head + kLine - delay_whole_) % kLine];
-  const double b = line[(head + kLine - delay_whole_ - 1) % kLine];
-  return a + delay_frac_ * (b - a);
+  const auto back = [&](std::size_t samples) { return line[(head + kLine - samples) % kLine]; };
+  const double a = back(delay_whole_);
+  if (delay_frac_ == 0.0) return a;
+  if (delay_whole_ == 0) return a + delay_frac_ * (back(1) - a);
+  // The delayed instant lies 1 - frac after the older sample of the two around it.
+  const std::array<double, 4> w = cubic_read_weights(1.0 - delay_frac_);
+  return w[0] * back(delay_whole_ + 2) + w[1] * back(delay_whole_ + 1) + w[2] * a +
+         w[3] * back(delay_whole_ - 1);
 }
 
 double CorrectionStage::delayed(double value) noexcept {

@@ -5,7 +5,8 @@
 // tests/diagnosis/independent_draws_test.cpp.
 //
 //   build/tests/bench/diagnosis_draws [--effect NAME|all] [--draws N] [--seed-base S]
-//                                     [--threads T]
+//                                     [--threads T] [--evidence 1]
+// --evidence 1 prints each finding's evidence under its draw's line.
 //
 // Defaults: all effects, 3 draws each, seed base 900000 (the development range), 1 thread.
 // Draw i of an effect has seed S + i. One line per draw (effect, seed, ratio drawn -> achieved,
@@ -37,13 +38,14 @@ struct Arguments {
   std::uint64_t draws{3};
   std::uint64_t seed_base{900000};
   unsigned threads{1};
+  bool evidence{false};  // each finding's evidence under its draw's line
 };
 
 [[noreturn]] void usage(const char* why) {
   static_cast<void>(
       std::fprintf(stderr,
                    "diagnosis_draws: %s\nusage: diagnosis_draws [--effect NAME|all] [--draws N] "
-                   "[--seed-base S] [--threads T]\n",
+                   "[--seed-base S] [--threads T] [--evidence 1]\n",
                    why));
   std::exit(2);
 }
@@ -74,6 +76,8 @@ Arguments parse(int argc, char** argv) {
       a.draws = number(value);
     } else if (key == "--seed-base") {
       a.seed_base = number(value);
+    } else if (key == "--evidence") {
+      a.evidence = number(value) != 0;
     } else if (key == "--threads") {
       a.threads = static_cast<unsigned>(std::max<std::uint64_t>(1, number(value)));
     } else {
@@ -130,6 +134,10 @@ int main(int argc, char** argv) {
         Outcome o = selfsense::independent::run_draw(jobs[i].seed, jobs[i].effect);
         const std::lock_guard<std::mutex> lock(print);
         std::printf("%s\n", selfsense::independent::summary(o).c_str());
+        if (args.evidence) {
+          for (const selfsense::independent::Named& f : o.findings)
+            std::printf("    %s %s: %s\n", f.effect.c_str(), f.channel.c_str(), f.evidence.c_str());
+        }
         static_cast<void>(std::fflush(stdout));
         outcomes[i] = std::move(o);
         done[i] = true;

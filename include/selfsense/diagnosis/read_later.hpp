@@ -2,16 +2,12 @@
 // (reidentified.cpp): the record read `samples` later,
 //   v[k] = x(k + samples),
 // between samples by the cubic Lagrange interpolator through x[i-1], x[i], x[i+1], x[i+2]
-// (i = floor(k + samples), t = k + samples - i in [0, 1)):
-//   v = -t (t-1)(t-2)/6 x[i-1] + (t+1)(t-1)(t-2)/2 x[i] - (t+1) t (t-2)/2 x[i+1]
-//       + (t+1) t (t-1)/6 x[i+2],
-// linear where a neighbour falls outside the record, the last sample held beyond it.
-// Why cubic: a component of w rad per sample read linearly loses about t (1 - t) w^2 / 2 of
-// itself (a low-pass), which the side identified on the record takes in; the delay stage then
-// smooths it once more, so a sub-sample delay re-identified on a linear read carried twice the
-// interpolation error to fast excitation (development draw 900003: docs/diagnose.md, "A delay
-// the rounds named, carried by the side identified with it"). The cubic read's error
-// is about |(t+1) t (t-1)(t-2)| w^4 / 24 (2e-4 of the component at 0.3 rad per sample).
+// (i = floor(k + samples), t = k + samples - i in [0, 1); models/cubic_read.hpp), linear where
+// a neighbour falls outside the record, the last sample held beyond it.
+// Why cubic: a linear read low-passes what it reads, which the side identified on the record
+// takes in; the delay stage then smooths it once more, so a sub-sample delay re-identified on a
+// linear read carried twice the interpolation error to fast excitation (development draw
+// 900003: docs/diagnose.md, "A delay the rounds named, carried by the side identified with it").
 // Not causal: the whole record at once.
 #pragma once
 

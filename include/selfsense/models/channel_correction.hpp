@@ -38,7 +38,8 @@
 //       f2 and zeta2, and a share a of v that passes neither: unity DC gain still)
 //   m[k] = g m[k-1] + c (w[k] - w[k-1]),  g = exp(-Ts/tau), c = (1 - g) tau / Ts,  m = w at the
 //       start                                                     charge_leakage
-//   out[k] = m(k Ts - delay)  (linear interpolation, delay <= 64 samples)        delay
+//   out[k] = m(k Ts - delay)  (delay <= 64 samples; below one sample linear      delay
+//       interpolation, from one on the cubic through four samples: models/cubic_read.hpp)
 // x: the drive (E for field drive), T: stress [Pa], theta: temperature [degC], s: the model's
 // sensed response to the drive alone (D - d T, d the sensor's coupling), r = y - coupling T the
 // channel's response to the drive alone (so a coupling that changes with stress,
