@@ -271,26 +271,38 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
       // A delay the rounds named alone: the side identified with it undone carries it where it
       // fits the record better than the delay after the model (the same class and parameter
       // count: the side fitted with the delay jointly against the side fitted without it and the
-      // delay after; the rounds' held-out test has named it already).
-      const Finding* named_delay =
-          found.size() == 1 && found.front().effect == "delay" ? &found.front() : nullptr;
+      // delay after; the rounds' held-out test has named it already). A mode named alone (by
+      // the rounds or in one stretch): the delay carried in its place where it is the simpler
+      // form of the lag on both halves (reidentified.hpp) and the side identified with it fits
+      // the record better than the mode after the model, which has a parameter more.
+      const bool one_lag = found.size() == 1 &&
+                           (found.front().effect == "delay" || found.front().effect == "dynamics");
+      const Finding* named_lag = one_lag ? &found.front() : nullptr;
       std::optional<Reidentified> late = reidentified_lag(
-          model, s, ch, model_output, options, st.lag_mode, seen, st.named_modes, named_delay);
+          model, s, ch, model_output, options, st.lag_mode, seen, st.named_modes, named_lag);
       if (late && late->carried) {
         const double carried_sse = sse_over(ch.recorded, late->output, rows.judge);
+        const bool was_delay = found.front().effect == "delay";
         if (carried_sse < st.current_sse) {
           late->finding.evidence += format(
-              "; carried by the model's side identified again with a delay of %.3g samples "
-              "undone, which fits the record %.0f %% better than the delay after the model (the "
-              "side had taken part of the delay in)",
+              was_delay ? "; carried by the model's side identified again with a delay of %.3g "
+                          "samples undone, which fits the record %.0f %% better than the delay "
+                          "after the model (the side had taken part of the delay in)"
+                        : "; the model's side identified again with a delay of %.3g samples "
+                          "undone fits the record %.0f %% better than the mode after the model",
               late->correction.delay_s / s.sample_time,
               100.0 * (1.0 - carried_sse / st.current_sse));
+          if (!was_delay && st.original_sse > 0.0) {
+            late->finding.explains = std::max(0.0, 1.0 - carried_sse / st.original_sse);
+          }
         } else {
           // The rounds' delay after the model stands; the finding says what was weighed.
-          found.front().evidence += format(
-              "; the model's side identified again with the delay undone fitted the record "
-              "%.0f %% worse than the delay after the model, which stands",
-              100.0 * (carried_sse / st.current_sse - 1.0));
+          if (was_delay) {
+            found.front().evidence += format(
+                "; the model's side identified again with the delay undone fitted the record "
+                "%.0f %% worse than the delay after the model, which stands",
+                100.0 * (carried_sse / st.current_sse - 1.0));
+          }
           late.reset();
         }
       }

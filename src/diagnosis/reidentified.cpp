@@ -281,6 +281,14 @@ std::optional<double> forecast_explains(const Trial& null, const Trial& best, co
   return explains;
 }
 
+// A trial's error over the second half (the rows a forecast judges).
+double forecast_sse(const Judge& judge, const ChannelData& ch, const Trial& null, const Trial& t,
+                    const Options& options) {
+  const Rows rows =
+      forecast_rows(ch.recorded.size(), judge.half(), options.blocks, null.forecast, t.forecast);
+  return sse_over(ch.recorded, t.forecast, rows.judge);
+}
+
 // The improved side: identified on the whole record with the effect undone.
 std::optional<Reidentified> identified_whole(const Judge& judge,
                                              const models::ChannelCorrection& effect,
@@ -481,7 +489,7 @@ std::optional<Reidentified> reidentified_lag(
     const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
     const std::vector<double>& current, const Options& options,
     const models::ChannelCorrection& mode_seed, LagSeen seen,
-    const models::ChannelCorrection& named_modes, const Finding* named_delay) {
+    const models::ChannelCorrection& named_modes, const Finding* named_lag) {
   if (!reidentifiable(model, s, ch)) return std::nullopt;
   const Judge judge(model, s, ch);
   const double most = static_cast<double>(models::kMaxCorrectionDelaySamples) * s.sample_time;
@@ -535,6 +543,7 @@ std::optional<Reidentified> reidentified_lag(
   // damping within 2) are tried the same way, and one replaces the delay where the delay leaves
   // parsimony_ratio times its residual on the first half (the simpler lag otherwise).
   bool mode = false;
+  Trial best_mode;
   if (!ch.sensed && mode_seed.dynamics_frequency_hz > 0.0) {
     const auto with_mode = [](double hz, double zeta) {
       models::ChannelCorrection c;
@@ -557,7 +566,7 @@ std::optional<Reidentified> reidentified_lag(
         out.push_back(with_mode(c.dynamics_frequency_hz, z * c.dynamics_damping));
       return out;
     };
-    Trial best_mode = best_of(judge, modes, mode_neighbours, null.start);
+    best_mode = best_of(judge, modes, mode_neighbours, null.start);
     if (named_modes.dynamics_frequency_hz > 0.0) {
       // The rounds' two modes (or mode and direct path) as they were fitted, undone together.
       Trial block = in_full(judge, judge.trial(named_modes, null.start));
@@ -565,21 +574,42 @@ std::optional<Reidentified> reidentified_lag(
     }
     if (!best_mode.forecast.empty() &&
         best.first_half_sse > options.parsimony_ratio * best_mode.first_half_sse) {
-      best = std::move(best_mode);
+      best = best_mode;
       mode = true;
     }
   }
   std::optional<Reidentified> r = judged(judge, ch, null, best, options, ShownBy::kFitAndForecast);
-  if (!r && named_delay != nullptr && !mode) {
-    // Named by the rounds: the side identified on the whole record with the delay undone, for
-    // the caller to weigh against the delay after the model (Reidentified::carried).
-    r = identified_whole(judge, best.effect, ch, named_delay->explains);
+  // A lag named alone (rounds or local pass): the delay carried, for the caller to weigh against
+  // the correction after the model. In place of a named mode only where the delay is the simpler
+  // form of the same lag on both halves: within parsimony_ratio of the modes' fit of the first
+  // half (above) and no worse a forecast of the second.
+  const bool in_place_of_mode = named_lag != nullptr && named_lag->effect != "delay";
+  const bool carried =
+      !r && named_lag != nullptr && !mode &&
+      (!in_place_of_mode ||
+       (!best_mode.forecast.empty() && forecast_sse(judge, ch, null, best, options) <=
+                                           forecast_sse(judge, ch, null, best_mode, options)));
+  if (carried) {
+    // The side identified on the whole record with the delay undone (Reidentified::carried).
+    r = identified_whole(judge, best.effect, ch, named_lag->explains);
     if (!r) return std::nullopt;
     r->fit_explains = 1.0 - best.first_half_sse / null.first_half_sse;
     r->candidate = &candidate_using(CorrectionTerm::kDelay);
     r->terms = r->candidate->terms;
-    r->finding = *named_delay;
     r->carried = true;
+    if (!in_place_of_mode) {
+      r->finding = *named_lag;
+      return r;
+    }
+    r->finding.effect = r->candidate->effect;
+    r->finding.where = where_it_changes(r->output, current);
+    describe(r->finding, *r->candidate, r->correction, ch, s, current, r->output,
+             format("as the simpler form of the lag the mode named took: the side identified on "
+                    "the first half with the delay undone leaves %.0f %% of its error there (with "
+                    "the best mode undone %.0f %%) and forecasts the last %.3g s no worse",
+                    100.0 * best.first_half_sse / null.first_half_sse,
+                    100.0 * best_mode.first_half_sse / null.first_half_sse,
+                    static_cast<double>(s.drive.size() - judge.half()) * s.sample_time));
     return r;
   }
   if (!r) return std::nullopt;

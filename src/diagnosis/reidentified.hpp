@@ -194,20 +194,27 @@ inline constexpr std::size_t kReidentifiedRows = 200000;
 // best fits the first half by min_explains better than the null (no backcast in its place, no
 // refinement or mode before that): a few identifications on a channel with no lag.
 //
-// With `named_delay` (the rounds named a delay and nothing else on the channel), a delay that is
+// With `named_lag` (the rounds named a delay and nothing else on the channel), a delay that is
 // not judged against the null still comes back, carried (Reidentified::carried, with the rounds'
 // finding): the side identified on the whole record with the delay undone. The caller keeps it
 // where it fits the record better than the rounds' delay after the model: both are the side and
 // one delay, and the joint fit is not biased by the part of the delay the side took in (the
 // rounds read the sub-sample delays on D of 900003, 900006, 900017 and 900027 17-34 % short;
 // docs/diagnose.md, "A delay the rounds named, carried by the side identified with it").
+// Where `named_lag` is a mode named alone on S (by the rounds or the local pass, in one stretch),
+// the delay is carried in its place (a finding of its own) where it is the simpler form of the
+// same lag: the delay chosen over the modes by the first half's fit (parsimony_ratio, above) and
+// its forecast of the second half no worse than the best mode's. The signed-rank test of the
+// forecast blocks needs no pass here: the lag was named already, and only its form is chosen (a
+// delay shows at the fast moves only, so on the slow blocks of a forecast the sign of the change
+// is noise: 900008's delay forecast 71 % better at p = 0.038).
 enum class LagSeen { kInRounds, kNo };
 
 [[nodiscard]] std::optional<Reidentified> reidentified_lag(
     const models::TransducerModel& model, const Signals& s, const ChannelData& ch,
     const std::vector<double>& current, const Options& options,
     const models::ChannelCorrection& mode_seed = {}, LagSeen seen = LagSeen::kInRounds,
-    const models::ChannelCorrection& named_modes = {}, const Finding* named_delay = nullptr);
+    const models::ChannelCorrection& named_modes = {}, const Finding* named_lag = nullptr);
 
 }  // namespace selfsense::diagnosis::detail
 
