@@ -283,18 +283,23 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
       if (late && late->carried) {
         const double carried_sse = sse_over(ch.recorded, late->output, rows.judge);
         const bool was_delay = found.front().effect == "delay";
-        if (carried_sse < st.current_sse) {
+        if (carried_sse < st.current_sse && was_delay) {
           late->finding.evidence += format(
-              was_delay ? "; carried by the model's side identified again with a delay of %.3g "
-                          "samples undone, which fits the record %.0f %% better than the delay "
-                          "after the model (the side had taken part of the delay in)"
-                        : "; the model's side identified again with a delay of %.3g samples "
-                          "undone fits the record %.0f %% better than the mode after the model",
+              "; carried by the model's side identified again with a delay of %.3g samples "
+              "undone, which fits the record %.0f %% better than the delay after the model (the "
+              "side had taken part of the delay in)",
               late->correction.delay_s / s.sample_time,
               100.0 * (1.0 - carried_sse / st.current_sse));
-          if (!was_delay && st.original_sse > 0.0) {
-            late->finding.explains = std::max(0.0, 1.0 - carried_sse / st.original_sse);
-          }
+        } else if (carried_sse < st.current_sse) {
+          // In the mode's place: a finding of its own, its share of the held-out residual.
+          late->finding.explains =
+              st.original_sse > 0.0 ? std::max(0.0, 1.0 - carried_sse / st.original_sse) : 0.0;
+          const std::string judged = late->finding.evidence;
+          describe(late->finding, *late->candidate, late->correction, ch, s, model_output,
+                   late->output,
+                   judged + format("; the model's side identified again with it undone fits the "
+                                   "record %.0f %% better than the mode after the model",
+                                   100.0 * (1.0 - carried_sse / st.current_sse)));
         } else {
           // The rounds' delay after the model stands; the finding says what was weighed.
           if (was_delay) {

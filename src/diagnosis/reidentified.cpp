@@ -601,15 +601,17 @@ std::optional<Reidentified> reidentified_lag(
       r->finding = *named_lag;
       return r;
     }
+    // Described by the caller once it has weighed the side against the mode (its share of the
+    // held-out residual goes into the text); until then the evidence holds what chose the form.
     r->finding.effect = r->candidate->effect;
     r->finding.where = where_it_changes(r->output, current);
-    describe(r->finding, *r->candidate, r->correction, ch, s, current, r->output,
-             format("as the simpler form of the lag the mode named took: the side identified on "
-                    "the first half with the delay undone leaves %.0f %% of its error there (with "
-                    "the best mode undone %.0f %%) and forecasts the last %.3g s no worse",
-                    100.0 * best.first_half_sse / null.first_half_sse,
-                    100.0 * best_mode.first_half_sse / null.first_half_sse,
-                    static_cast<double>(s.drive.size() - judge.half()) * s.sample_time));
+    r->finding.evidence = format(
+        "as the simpler form of the lag the mode named took: the side identified on the "
+        "first half with the delay undone leaves %.0f %% of its error there (with the best "
+        "mode undone %.0f %%) and forecasts the last %.3g s no worse",
+        100.0 * best.first_half_sse / null.first_half_sse,
+        100.0 * best_mode.first_half_sse / null.first_half_sse,
+        static_cast<double>(s.drive.size() - judge.half()) * s.sample_time);
     return r;
   }
   if (!r) return std::nullopt;
