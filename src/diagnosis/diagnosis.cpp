@@ -282,7 +282,7 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
           model, s, ch, model_output, options, st.lag_mode, seen, st.named_modes, named_lag);
       if (late && late->carried) {
         const double carried_sse = sse_over(ch.recorded, late->output, rows.judge);
-        const bool was_delay = found.front().effect == "delay";
+        const bool was_delay = named_lag != nullptr && named_lag->effect == "delay";
         if (carried_sse < st.current_sse && was_delay) {
           late->finding.evidence += format(
               "; carried by the model's side identified again with a delay of %.3g samples "
@@ -291,7 +291,9 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
               late->correction.delay_s / s.sample_time,
               100.0 * (1.0 - carried_sse / st.current_sse));
         } else if (carried_sse < st.current_sse) {
-          // In the mode's place: a finding of its own, its share of the held-out residual.
+          // In the mode's place: a finding of its own, its share of the residual on the judged
+          // rows (which the side saw when identified on the whole record, as a carried delay's;
+          // the contract's share for a finding of the rounds is held out).
           late->finding.explains =
               st.original_sse > 0.0 ? std::max(0.0, 1.0 - carried_sse / st.original_sse) : 0.0;
           const std::string judged = late->finding.evidence;

@@ -281,12 +281,13 @@ std::optional<double> forecast_explains(const Trial& null, const Trial& best, co
   return explains;
 }
 
-// A trial's error over the second half (the rows a forecast judges).
-double forecast_sse(const Judge& judge, const ChannelData& ch, const Trial& null, const Trial& t,
-                    const Options& options) {
+// `a` forecasts the second half no worse than `b` (over the rows where both are finite).
+bool forecasts_no_worse(const Judge& judge, const ChannelData& ch, const Trial& a, const Trial& b,
+                        const Options& options) {
   const Rows rows =
-      forecast_rows(ch.recorded.size(), judge.half(), options.blocks, null.forecast, t.forecast);
-  return sse_over(ch.recorded, t.forecast, rows.judge);
+      forecast_rows(ch.recorded.size(), judge.half(), options.blocks, a.forecast, b.forecast);
+  return sse_over(ch.recorded, a.forecast, rows.judge) <=
+         sse_over(ch.recorded, b.forecast, rows.judge);
 }
 
 // The improved side: identified on the whole record with the effect undone.
@@ -574,7 +575,7 @@ std::optional<Reidentified> reidentified_lag(
     }
     if (!best_mode.forecast.empty() &&
         best.first_half_sse > options.parsimony_ratio * best_mode.first_half_sse) {
-      best = best_mode;
+      best = best_mode;  // a copy: read again below where a delay is carried in its place
       mode = true;
     }
   }
@@ -583,12 +584,12 @@ std::optional<Reidentified> reidentified_lag(
   // the correction after the model. In place of a named mode only where the delay is the simpler
   // form of the same lag on both halves: within parsimony_ratio of the modes' fit of the first
   // half (above) and no worse a forecast of the second.
-  const bool in_place_of_mode = named_lag != nullptr && named_lag->effect != "delay";
-  const bool carried =
-      !r && named_lag != nullptr && !mode &&
-      (!in_place_of_mode ||
-       (!best_mode.forecast.empty() && forecast_sse(judge, ch, null, best, options) <=
-                                           forecast_sse(judge, ch, null, best_mode, options)));
+  const bool in_place_of_mode = named_lag != nullptr && named_lag->effect == "dynamics";
+  const bool carried = !r && !mode &&
+                       ((named_lag != nullptr && named_lag->effect == "delay") ||
+                        (in_place_of_mode && !best_mode.forecast.empty() &&
+                         std::isfinite(best_mode.first_half_sse) &&
+                         forecasts_no_worse(judge, ch, best, best_mode, options)));
   if (carried) {
     // The side identified on the whole record with the delay undone (Reidentified::carried).
     r = identified_whole(judge, best.effect, ch, named_lag->explains);

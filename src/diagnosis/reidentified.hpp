@@ -54,7 +54,9 @@ struct Reidentified {
   // The structure the side was identified with, when it is not the model's (creep operators
   // added to a hysteresis model).
   std::optional<models::Structure> structure{};
-  // Not judged against the null: a side to carry an effect the rounds named (its finding).
+  // Not judged against the null: a side to carry an effect the rounds named (with their finding),
+  // or a delay in the place of a mode they named (a finding of its own, which the caller
+  // describes once it has weighed the side: until then its evidence says what chose the form).
   bool carried{false};
 };
 
@@ -194,7 +196,7 @@ inline constexpr std::size_t kReidentifiedRows = 200000;
 // best fits the first half by min_explains better than the null (no backcast in its place, no
 // refinement or mode before that): a few identifications on a channel with no lag.
 //
-// With `named_lag` (the rounds named a delay and nothing else on the channel), a delay that is
+// With `named_lag` a delay the rounds named and nothing else on the channel, a delay that is
 // not judged against the null still comes back, carried (Reidentified::carried, with the rounds'
 // finding): the side identified on the whole record with the delay undone. The caller keeps it
 // where it fits the record better than the rounds' delay after the model: both are the side and
@@ -204,7 +206,8 @@ inline constexpr std::size_t kReidentifiedRows = 200000;
 // Where `named_lag` is a mode named alone on S (by the rounds or the local pass, in one stretch),
 // the delay is carried in its place (a finding of its own) where it is the simpler form of the
 // same lag: the delay chosen over the modes by the first half's fit (parsimony_ratio, above) and
-// its forecast of the second half no worse than the best mode's. The signed-rank test of the
+// its forecast of the second half no worse than the best mode's (both on the rows where both
+// forecasts are finite); its finding is then the caller's to describe. The signed-rank test of the
 // forecast blocks needs no pass here: the lag was named already, and only its form is chosen (a
 // delay shows at the fast moves only, so on the slow blocks of a forecast the sign of the change
 // is noise: 900008's delay forecast 71 % better at p = 0.038).
