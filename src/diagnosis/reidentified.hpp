@@ -207,10 +207,11 @@ inline constexpr std::size_t kReidentifiedRows = 200000;
 // the delay is carried in its place (a finding of its own) where it is the simpler form of the
 // same lag: the delay chosen over the modes by the first half's fit (parsimony_ratio, above) and
 // its forecast of the second half no worse than the best mode's (both on the rows where both
-// forecasts are finite); its finding is then the caller's to describe. The signed-rank test of the
-// forecast blocks needs no pass here: the lag was named already, and only its form is chosen (a
-// delay shows at the fast moves only, so on the slow blocks of a forecast the sign of the change
-// is noise: 900008's delay forecast 71 % better at p = 0.038).
+// forecasts are finite); its finding is then the caller's to describe (and to refuse where the
+// side fits the record, or the mode's stretches, worse than the mode after the model). The
+// signed-rank test of the forecast blocks needs no pass here: the lag was named already, and only
+// its form is chosen (a delay shows at the fast moves only, so on the slow blocks of a forecast the
+// sign of the change is noise: 900008's delay forecast 71 % better at p = 0.038).
 enum class LagSeen { kInRounds, kNo };
 
 [[nodiscard]] std::optional<Reidentified> reidentified_lag(
