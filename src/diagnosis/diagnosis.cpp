@@ -283,26 +283,25 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
       const Finding* named_lag = one_lag ? &found.front() : nullptr;
       std::optional<Reidentified> late = reidentified_lag(
           model, s, ch, model_output, options, st.lag_mode, seen, st.named_modes, named_lag);
-      if (late && late->carried && named_lag != nullptr && named_lag->effect != "delay") {
-        double where_carried = 0.0;
-        double where_mode = 0.0;
-        for (const Segment& w : named_lag->where) {
-          where_carried += segment_sse(ch.recorded, late->output, w);
-          where_mode += segment_sse(ch.recorded, st.current, w);
-        }
-        if (where_carried > where_mode) late.reset();
-      }
-      if (late && late->carried) {
+      if (late && late->carried && named_lag != nullptr) {
         const double carried_sse = sse_over(ch.recorded, late->output, rows.judge);
-        const bool was_delay = named_lag != nullptr && named_lag->effect == "delay";
-        if (carried_sse < st.current_sse && was_delay) {
+        const bool was_delay = named_lag->effect == "delay";
+        const auto where_named_sse = [&](const std::vector<double>& output) {
+          double sse = 0.0;
+          for (const Segment& w : named_lag->where)
+            sse += segment_sse(ch.recorded, output, w);
+          return sse;
+        };
+        const bool fits_better = carried_sse < st.current_sse;
+        if (was_delay && fits_better) {
           late->finding.evidence += format(
               "; carried by the model's side identified again with a delay of %.3g samples "
               "undone, which fits the record %.0f %% better than the delay after the model (the "
               "side had taken part of the delay in)",
               late->correction.delay_s / s.sample_time,
               100.0 * (1.0 - carried_sse / st.current_sse));
-        } else if (carried_sse < st.current_sse) {
+        } else if (!was_delay && fits_better &&
+                   where_named_sse(late->output) <= where_named_sse(st.current)) {
           // In the mode's place: a finding of its own, its share of the residual on the judged
           // rows (which the side saw when identified on the whole record, as a carried delay's;
           // the contract's share for a finding of the rounds is held out).
@@ -315,7 +314,7 @@ Result diagnose_channels(const Context& c, std::vector<ChannelData> channels, Ou
                                    "record %.0f %% better than the mode after the model",
                                    100.0 * (1.0 - carried_sse / st.current_sse)));
         } else {
-          // The rounds' delay after the model stands; the finding says what was weighed.
+          // The rounds' finding and model stand; for a delay the finding says what was weighed.
           if (was_delay) {
             found.front().evidence += format(
                 "; the model's side identified again with the delay undone fitted the record "

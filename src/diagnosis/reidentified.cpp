@@ -603,7 +603,8 @@ std::optional<Reidentified> reidentified_lag(
       return r;
     }
     // Described by the caller once it has weighed the side against the mode (its share of the
-    // held-out residual goes into the text); until then the evidence holds what chose the form.
+    // residual on the judged rows goes into the text); until then the evidence holds what chose
+    // the form.
     r->finding.effect = r->candidate->effect;
     r->finding.where = where_it_changes(r->output, current);
     r->finding.evidence = format(
